@@ -1,0 +1,62 @@
+// Collision queries: which bodies a finger's path touches (FCL), and the exact box geometry the
+// god-object is constrained to (which face the path entered, where, and how deep).
+#pragma once
+
+#include <memory>
+#include <optional>
+#include <vector>
+
+#include "graspsim/engine/math.hpp"
+#include "graspsim/engine/model.hpp"
+#include "graspsim/engine/state.hpp"
+
+namespace graspsim {
+
+// A face plane of a box in the body frame: points x on the face satisfy normal . x = offset;
+// normal points out of the box.
+struct Face {
+  Vec3 normal;     // 1, body frame
+  double offset;   // m
+};
+
+// Face k of a box with half sizes h: 0..5 = +x, -x, +y, -y, +z, -z.
+Face box_face(const Vec3& half_extents, int face);
+
+// True when x (body frame) lies in the prism swept by face k along its normal, that is, its
+// coordinates across the face are within the face's rectangle (edges included).
+bool within_face(const Vec3& half_extents, int face, const Vec3& x);
+
+// Where a finger path a -> b (body frame) enters a box.
+struct BoxEntry {
+  int face;       // entered face, 0..5
+  Vec3 point;     // m, body frame: entry point on that face
+  double t;       // 1: fraction of the path a -> b at entry (0 when a was already inside)
+};
+
+// The entry of the path a -> b into the box when b is inside it (surface included), else none.
+// The face is the one the path crossed first: the one entered, not the nearest to b, which is
+// what keeps a deep finger from pushing through to the far side. When a is already inside (the
+// body moved onto the finger, or the first tick), the face nearest to b is taken.
+std::optional<BoxEntry> box_entry(const Vec3& half_extents, const Vec3& a, const Vec3& b);
+
+// FCL collision objects of the bodies, kept at the bodies' poses.
+class CollisionWorld {
+ public:
+  explicit CollisionWorld(const Model& model);
+  ~CollisionWorld();
+  CollisionWorld(CollisionWorld&&) noexcept;
+  CollisionWorld& operator=(CollisionWorld&&) noexcept;
+
+  // Moves the FCL objects to the bodies' current poses.
+  void update(const State& state);
+
+  // Indices of the bodies that the segment a -> b (world) touches, ascending, written into
+  // `out` (cleared first; no allocation once its capacity suffices).
+  void bodies_touching_segment(const Vec3& a, const Vec3& b, std::vector<int>& out) const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace graspsim

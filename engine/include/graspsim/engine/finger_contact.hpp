@@ -1,0 +1,46 @@
+// Finger contact: the paper's friction cone algorithm (section 2), one finger at a time, and
+// the spring force between the haptic interface point (HIP) and the god-object (GO).
+#pragma once
+
+#include <vector>
+
+#include "graspsim/engine/collision.hpp"
+#include "graspsim/engine/math.hpp"
+#include "graspsim/engine/model.hpp"
+#include "graspsim/engine/record.hpp"
+#include "graspsim/engine/state.hpp"
+
+namespace graspsim {
+
+// Steps 3 and 4 of the algorithm: the god-object stays put while it lies within the friction
+// circle of `radius` about the surface point `sp`; outside it, it moves onto the circle, on the
+// line towards `sp`. Compares squared distances, so no root is taken while the finger sticks.
+// Returns true when the god-object moved (the finger slipped).
+inline bool friction_circle_step(const Vec3& sp, double radius, Vec3& go) {
+  const Vec3 d = go - sp;
+  const double d2 = d.squaredNorm();
+  if (d2 <= radius * radius) return false;
+  go = sp + d * (radius / std::sqrt(d2));
+  return true;
+}
+
+// Contact parameters of finger f on body b (or kFloor): the pad and the surface in series.
+ContactPair finger_contact_pair(const Model& model, int finger, int body);
+
+// One haptic tick of finger f with the HIP at `hip` (m, world): finds a new contact when the
+// finger is free (the face its path entered), else runs the friction cone on the contacted face.
+// Fills every field of `rec` but `force`, which the servo stage sets (finger_force()).
+// `scratch` holds candidate bodies (kept to avoid allocation).
+void finger_haptic_step(const Model& model, const State& state, const CollisionWorld& collision,
+                        int finger, const Vec3& hip, FingerState& fs, HapticFingerRecord& rec,
+                        std::vector<int>& scratch);
+
+// Force on the finger for the newest HIP: k (GO - HIP) + c (v_GO - v_HIP), with k the pad and
+// surface in series, c the finger's damping, v_GO the velocity of the body point under the GO
+// and v_HIP = (HIP - previous HIP) * servo rate. Zero when free, and zero when it would pull the
+// finger into the face (a contact pushes, never pulls); with damping, the tangential part is
+// limited to mu times the normal part. `go_world` receives the GO (m, world).
+Vec3 finger_force(const Model& model, const State& state, int finger, const Vec3& hip,
+                  Vec3& go_world);
+
+}  // namespace graspsim

@@ -1,0 +1,90 @@
+// Model: everything constant during a run (MuJoCo's mjModel). Stages take `const Model&`.
+// SI units throughout; each field says its unit.
+#pragma once
+
+#include <cstdint>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "graspsim/engine/math.hpp"
+
+namespace graspsim {
+
+inline constexpr double kInfinity = std::numeric_limits<double>::infinity();
+
+// Loop rates. Each must divide `servo`; the scheduler runs on the servo tick.
+struct Rates {
+  int servo = 3000;   // Hz: device read and force render
+  int haptic = 500;   // Hz: finger contact (friction cone)
+  int physics = 50;   // Hz: object contacts and rigid-body integration
+};
+
+// Surface material. A contact between two surfaces combines them (see contact_pair()).
+struct Material {
+  double mu = 0.5;                // 1: Coulomb friction coefficient (friction-circle radius / depth)
+  double stiffness = kInfinity;   // N/m: penalty stiffness of the surface layer (per contact point)
+  double damping = kInfinity;     // N s/m: damping of the surface layer (per contact point)
+};
+
+// The parameters of one contact between two materials: the surface layers act as springs and
+// dampers in series (1/k = 1/k_a + 1/k_b), and friction is the lower of the two coefficients,
+// so an unset (infinite) side leaves the other one in charge.
+struct ContactPair {
+  double mu;          // 1
+  double stiffness;   // N/m
+  double damping;     // N s/m
+};
+ContactPair contact_pair(const Material& a, const Material& b);
+
+enum class ShapeKind { kBox };
+
+struct BodyParams {
+  std::string name;
+  ShapeKind shape = ShapeKind::kBox;
+  Vec3 half_extents{0.05, 0.05, 0.05};          // m: box half sizes along body x, y, z
+  double mass = 1.0;                            // kg
+  Vec3 inertia{1.0, 1.0, 1.0};                  // kg m^2: principal moments Jp (body axes)
+  Material material;
+  // Initial conditions (constant inputs; the State starts from them).
+  Vec3 position{0.0, 0.0, 0.0};                 // m: centre of mass in world
+  Quat orientation = Quat::Identity();          // 1: body to world rotation
+  Vec3 velocity{0.0, 0.0, 0.0};                 // m/s
+  Vec3 angular_velocity{0.0, 0.0, 0.0};         // rad/s, world frame
+};
+
+struct FingerParams {
+  std::string name;
+  double stiffness = 500.0;   // N/m: virtual coupling between HIP and god-object (finger pad)
+  double damping = 0.0;       // N s/m: damping of that coupling on the GO-HIP relative velocity
+                              //        (0 is the paper's pure spring)
+};
+
+struct FloorParams {
+  bool enabled = false;
+  double height = 0.0;        // m: the plane z = height, normal +z
+  Material material{1.0, kInfinity, kInfinity};
+};
+
+struct Model {
+  Rates rates;
+  Vec3 gravity{0.0, 0.0, -9.81};   // m/s^2
+  FloorParams floor;
+  std::vector<BodyParams> bodies;
+  std::vector<FingerParams> fingers;
+};
+
+// Divisors of the servo rate, derived once from the rates.
+struct Divisors {
+  std::int64_t haptic;    // servo ticks per haptic tick
+  std::int64_t physics;   // servo ticks per physics tick
+};
+
+// Checks the model and throws std::invalid_argument naming the offending field.
+void validate(const Model& model);
+Divisors divisors(const Rates& rates);
+
+// Principal moments of a solid box of mass m and half sizes h: J_x = m/3 (h_y^2 + h_z^2), etc.
+Vec3 box_inertia(double mass, const Vec3& half_extents);
+
+}  // namespace graspsim

@@ -1,0 +1,62 @@
+// Records: write-only outputs of one servo tick. The engine fills them and never reads them back;
+// recordings/ turns them into trace rows. Buffers are sized once (make_tick_record) so that the
+// step allocates nothing.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "graspsim/engine/math.hpp"
+#include "graspsim/engine/model.hpp"
+#include "graspsim/engine/state.hpp"
+
+namespace graspsim {
+
+// Device input of one finger for one servo tick.
+struct FingerInput {
+  Vec3 hip{0.0, 0.0, 0.0};   // m, world: haptic interface point
+};
+
+struct Input {
+  std::vector<FingerInput> fingers;   // same order as Model::fingers
+};
+
+struct ServoFingerRecord {
+  Vec3 hip{0.0, 0.0, 0.0};     // m, world
+  Vec3 force{0.0, 0.0, 0.0};   // N, world: k (GO - HIP) demanded for the device (before clamping)
+};
+
+struct HapticFingerRecord {
+  Vec3 god_object{0.0, 0.0, 0.0};      // m, world (= HIP when free)
+  Vec3 surface_point{0.0, 0.0, 0.0};   // m, world: HIP projected on the contacted face (= HIP free)
+  double depth = 0.0;                  // m: penetration of the HIP below the contacted face
+  double friction_radius = 0.0;        // m: mu * depth
+  Vec3 force{0.0, 0.0, 0.0};           // N, world: force on the finger (the servo force of this tick)
+  ContactPhase phase = ContactPhase::kFree;
+  int body = kNoBody;                  // contacted body index, kFloor or kNoBody
+  double slip = 0.0;                   // m: distance the GO moved over the surface this tick
+};
+
+struct BodyRecord {
+  Vec3 position{0.0, 0.0, 0.0};           // m, world
+  Quat orientation = Quat::Identity();    // 1: body to world, w >= 0
+  Vec3 velocity{0.0, 0.0, 0.0};           // m/s, world
+  Vec3 angular_velocity{0.0, 0.0, 0.0};   // rad/s, world
+  Vec3 force{0.0, 0.0, 0.0};              // N, world: residual force applied this step
+  Vec3 torque{0.0, 0.0, 0.0};             // N m, world: residual torque about the centre of mass
+  int floor_contacts = 0;                 // 1: vertices touching the floor
+};
+
+struct TickRecord {
+  std::int64_t tick = 0;   // servo tick this record belongs to
+  bool haptic_ran = false;
+  bool physics_ran = false;
+  std::vector<ServoFingerRecord> servo;     // per finger, every tick
+  std::vector<HapticFingerRecord> haptic;   // per finger, valid when haptic_ran
+  std::vector<BodyRecord> physics;          // per body, valid when physics_ran
+};
+
+TickRecord make_tick_record(const Model& model);
+Input make_input(const Model& model);
+
+}  // namespace graspsim

@@ -1,0 +1,45 @@
+// The simulation: a Model, its State, and the fixed order of work inside one servo tick.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "graspsim/engine/collision.hpp"
+#include "graspsim/engine/model.hpp"
+#include "graspsim/engine/record.hpp"
+#include "graspsim/engine/state.hpp"
+
+namespace graspsim {
+
+class Simulation {
+ public:
+  // Validates the model (std::invalid_argument naming the field) and starts from its initial state.
+  explicit Simulation(Model model);
+
+  // One servo tick, in this order (the only place the order is written):
+  //   1 servo    the HIP of every finger from `input`
+  //   2 haptic   (tick % (servo/haptic) == 0) friction cone for every finger, in finger order
+  //   3 servo    force on every finger, k (GO - HIP) with the newest HIP; its reaction, acting at
+  //              the GO, is added to the contacted body's physics window
+  //   4 physics  (tick % (servo/physics) == 0) for every body, in body order: record the state at
+  //              this tick; residual F = mean finger force over the window + floor + m g and
+  //              T = mean finger torque + floor torque; integrate over 1/physics s; clear window
+  //   5 tick += 1
+  // Time is tick / servo, computed, never accumulated.
+  void step(const Input& input, TickRecord& record);
+
+  const Model& model() const { return model_; }
+  const State& state() const { return state_; }
+  const Divisors& divisors() const { return divisors_; }
+  std::int64_t tick() const { return state_.tick; }
+  double time() const { return static_cast<double>(state_.tick) / model_.rates.servo; }   // s
+
+ private:
+  Model model_;
+  Divisors divisors_;
+  State state_;
+  CollisionWorld collision_;
+  std::vector<int> scratch_;   // candidate bodies of a finger query
+};
+
+}  // namespace graspsim

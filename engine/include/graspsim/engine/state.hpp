@@ -1,0 +1,59 @@
+// State: exactly what carries from one servo tick to the next. Saving it (with the Model)
+// is enough to resume a run; anything not here is recomputed by the step.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "graspsim/engine/math.hpp"
+#include "graspsim/engine/model.hpp"
+
+namespace graspsim {
+
+inline constexpr int kNoBody = -1;   // FingerState::body when the finger touches nothing
+inline constexpr int kFloor = -2;    // FingerState::body when the finger touches the floor
+
+// Friction-cone phase of a finger (traced as 0, 1, 2).
+enum class ContactPhase : std::int8_t { kFree = 0, kStick = 1, kSlip = 2 };
+
+struct FingerState {
+  Vec3 hip_at_last_servo{0.0, 0.0, 0.0};    // m, world: HIP of the previous servo tick
+  Vec3 hip_at_last_haptic{0.0, 0.0, 0.0};   // m, world: HIP used by the previous haptic tick
+  bool has_last_haptic = false;             // false until the first haptic tick
+  ContactPhase phase = ContactPhase::kFree;
+  int body = kNoBody;                       // index into Model::bodies, kFloor or kNoBody
+  int face = 0;                             // contacted face: box 0..5 = +x,-x,+y,-y,+z,-z; floor 0
+  Vec3 god_object{0.0, 0.0, 0.0};           // m: GO in the contacted body's frame (world for the
+                                            //    floor), so it rides with the body
+};
+
+// One vertex of a body against the floor: its friction anchor (the paper's god-object idea
+// applied to object contact) while the vertex penetrates.
+struct VertexContact {
+  bool active = false;
+  Vec3 anchor{0.0, 0.0, 0.0};   // m, world: where the vertex stuck to the floor
+};
+
+struct BodyState {
+  Vec3 position{0.0, 0.0, 0.0};           // m: centre of mass, world
+  Mat3 rotation = Mat3::Identity();       // 1: body to world (R = [n o a])
+  Vec3 velocity{0.0, 0.0, 0.0};           // m/s, world
+  Vec3 angular_velocity{0.0, 0.0, 0.0};   // rad/s, world
+  std::array<VertexContact, 8> floor_contacts{};   // box vertices against the floor
+  // Finger wrench accumulated over the current physics window (sum over servo ticks).
+  Vec3 window_force{0.0, 0.0, 0.0};       // N (summed, divide by window_ticks)
+  Vec3 window_torque{0.0, 0.0, 0.0};      // N m about the centre of mass (summed)
+};
+
+struct State {
+  std::int64_t tick = 0;              // servo ticks done; time = tick / servo rate
+  std::int64_t window_ticks = 0;      // servo ticks accumulated into the physics window
+  std::vector<BodyState> bodies;      // same order as Model::bodies
+  std::vector<FingerState> fingers;   // same order as Model::fingers
+};
+
+// The state at t = 0 given by the model's initial conditions.
+State initial_state(const Model& model);
+
+}  // namespace graspsim

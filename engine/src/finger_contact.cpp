@@ -1,0 +1,163 @@
+// The friction cone algorithm of Melder, Harwin & Sharkey, section 2, per finger.
+#include "graspsim/engine/finger_contact.hpp"
+
+#include <cmath>
+
+namespace graspsim {
+namespace {
+
+// Pose of the frame a contact lives in: a body's, or the world's for the floor.
+struct Frame {
+  Mat3 R;   // 1: frame to world
+  Vec3 p;   // m: frame origin in world
+};
+
+Frame contact_frame(const State& state, int body) {
+  if (body >= 0) return Frame{state.bodies[body].rotation, state.bodies[body].position};
+  return Frame{Mat3::Identity(), Vec3::Zero()};
+}
+
+// The contacted face's plane in the contact frame.
+Face contact_face(const Model& model, int body, int face) {
+  if (body >= 0) return box_face(model.bodies[body].half_extents, face);
+  return Face{Vec3::UnitZ(), model.floor.height};
+}
+
+const Material& surface_material(const Model& model, int body) {
+  return body >= 0 ? model.bodies[body].material : model.floor.material;
+}
+
+}  // namespace
+
+ContactPair finger_contact_pair(const Model& model, int finger, int body) {
+  // The finger pad is a spring with no friction of its own: the surface's mu rules.
+  const Material pad{kInfinity, model.fingers[finger].stiffness, kInfinity};
+  return contact_pair(pad, surface_material(model, body));
+}
+
+void finger_haptic_step(const Model& model, const State& state, const CollisionWorld& collision,
+                        int finger, const Vec3& hip, FingerState& fs, HapticFingerRecord& rec,
+                        std::vector<int>& scratch) {
+  rec.slip = 0.0;
+  bool track = fs.phase != ContactPhase::kFree;
+
+  if (!track) {
+    // Free: did the path since the last haptic tick enter a surface? The earliest entry wins;
+    // ties go to the lower body index, then to the floor.
+    const Vec3 a = fs.has_last_haptic ? fs.hip_at_last_haptic : hip;
+    double best_t = kInfinity;
+    collision.bodies_touching_segment(a, hip, scratch);
+    for (int b : scratch) {
+      const BodyState& bs = state.bodies[b];
+      const Vec3 a_b = bs.rotation.transpose() * (a - bs.position);
+      const Vec3 hip_b = bs.rotation.transpose() * (hip - bs.position);
+      if (const auto e = box_entry(model.bodies[b].half_extents, a_b, hip_b); e && e->t < best_t) {
+        best_t = e->t;
+        fs.body = b;
+        fs.face = e->face;
+        fs.god_object = e->point;
+      }
+    }
+    const double h = model.floor.height;
+    if (model.floor.enabled && hip.z() < h) {
+      // Crossing z = h: the entry point on the plane; from below already, the HIP's projection.
+      const double t = a.z() >= h ? (a.z() - h) / (a.z() - hip.z()) : 0.0;
+      if (t < best_t) {
+        best_t = t;
+        fs.body = kFloor;
+        fs.face = 0;
+        fs.god_object = a + t * (hip - a);
+        if (a.z() < h) fs.god_object = hip;
+        fs.god_object.z() = h;
+      }
+    }
+    track = best_t <= 1.0;
+  }
+
+  if (track) {
+    const Frame fr = contact_frame(state, fs.body);
+    const Face face = contact_face(model, fs.body, fs.face);
+    const Vec3 hip_c = fr.R.transpose() * (hip - fr.p);   // HIP in the contact frame
+    // Step 1: the surface point SP, the HIP's projection on the entered face, and the depth.
+    const double depth = face.offset - face.normal.dot(hip_c);
+    const bool on_face = fs.body < 0 || within_face(model.bodies[fs.body].half_extents, fs.face, hip_c);
+    if (depth > 0.0 && on_face) {
+      const Vec3 sp = hip_c + depth * face.normal;
+      // Step 2: friction circle radius = mu * depth.
+      const ContactPair pair = finger_contact_pair(model, finger, fs.body);
+      const double radius = pair.mu * depth;
+      // Steps 3 and 4: move the GO onto the circle only when it lies outside.
+      const Vec3 before = fs.god_object;
+      const bool slipped = friction_circle_step(sp, radius, fs.god_object);
+      fs.phase = slipped ? ContactPhase::kSlip : ContactPhase::kStick;
+      rec.slip = slipped ? (fs.god_object - before).norm() : 0.0;
+      // Step 5, the force from HIP, GO and stiffness, is finger_force(), run at the servo rate.
+      const Vec3 go_w = fr.R * fs.god_object + fr.p;
+      rec.god_object = go_w;
+      rec.surface_point = fr.R * sp + fr.p;
+      rec.depth = depth;
+      rec.friction_radius = radius;
+      rec.phase = fs.phase;
+      rec.body = fs.body;
+    } else {
+      // Out through the entered face, or off its edge (the paper's algorithm does not cross
+      // polygon boundaries): the contact ends.
+      track = false;
+    }
+  }
+
+  if (!track) {
+    fs.phase = ContactPhase::kFree;
+    fs.body = kNoBody;
+    fs.god_object = hip;
+    rec.god_object = hip;
+    rec.surface_point = hip;
+    rec.depth = 0.0;
+    rec.friction_radius = 0.0;
+    rec.phase = ContactPhase::kFree;
+    rec.body = kNoBody;
+  }
+  fs.hip_at_last_haptic = hip;
+  fs.has_last_haptic = true;
+}
+
+Vec3 finger_force(const Model& model, const State& state, int finger, const Vec3& hip,
+                  Vec3& go_world) {
+  const FingerState& fs = state.fingers[finger];
+  if (fs.phase == ContactPhase::kFree) {
+    go_world = hip;
+    return Vec3::Zero();
+  }
+  const Frame fr = contact_frame(state, fs.body);
+  const Face face = contact_face(model, fs.body, fs.face);
+  go_world = fr.R * fs.god_object + fr.p;
+  const Vec3 n_w = fr.R * face.normal;
+  if (n_w.dot(go_world - hip) <= 0.0) return Vec3::Zero();   // HIP above the face: no pull
+  const ContactPair pair = finger_contact_pair(model, finger, fs.body);
+  Vec3 force = pair.stiffness * (go_world - hip);
+  const double c = model.fingers[finger].damping;
+  if (c > 0.0) {
+    // No previous sample on the first tick: the HIP is taken to be at rest.
+    const Vec3 v_hip = state.tick > 0
+        ? Vec3((hip - fs.hip_at_last_servo) * static_cast<double>(model.rates.servo))
+        : Vec3::Zero();
+    Vec3 v_go = Vec3::Zero();
+    if (fs.body >= 0) {
+      const BodyState& bs = state.bodies[fs.body];
+      v_go = bs.velocity + bs.angular_velocity.cross(go_world - bs.position);
+    }
+    force += c * (v_go - v_hip);
+    // The damper may neither pull (normal) nor carry more than friction allows (tangential):
+    // the whole contact force stays inside the cone |f_t| <= mu f_n. The spring alone is
+    // already inside it at haptic ticks; the damper is not, and would act as viscous drag
+    // while the finger slides.
+    const double f_n = n_w.dot(force);
+    if (f_n <= 0.0) return Vec3::Zero();
+    const Vec3 f_t = force - f_n * n_w;
+    const double limit = pair.mu * f_n;
+    if (f_t.squaredNorm() > limit * limit) force = f_n * n_w + f_t * (limit / f_t.norm());
+  }
+  return force;
+}
+
+}  // namespace graspsim

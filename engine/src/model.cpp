@@ -1,0 +1,100 @@
+// Model checks and derived constants.
+#include "graspsim/engine/model.hpp"
+
+#include <cmath>
+#include <set>
+#include <sstream>
+#include <stdexcept>
+
+namespace graspsim {
+namespace {
+
+[[noreturn]] void fail(const std::string& field, const std::string& what) {
+  throw std::invalid_argument(field + ": " + what);
+}
+
+std::string str(double v) {
+  std::ostringstream s;
+  s << v;
+  return s.str();
+}
+
+void check_material(const std::string& field, const Material& m) {
+  if (!(m.mu >= 0.0) || std::isinf(m.mu)) fail(field + ".mu", "must be >= 0 and finite (got " + str(m.mu) + ")");
+  if (!(m.stiffness > 0.0)) fail(field + ".stiffness", "must be > 0 N/m (got " + str(m.stiffness) + ")");
+  if (!(m.damping >= 0.0)) fail(field + ".damping", "must be >= 0 N s/m (got " + str(m.damping) + ")");
+}
+
+bool finite(const Vec3& v) { return v.allFinite(); }
+
+}  // namespace
+
+// Springs in series add compliances; dampers in series add "mobilities" (1/c). An infinite
+// layer contributes nothing, so a rigid side leaves the other in charge.
+ContactPair contact_pair(const Material& a, const Material& b) {
+  const auto series = [](double x, double y) {
+    if (std::isinf(x)) return y;
+    if (std::isinf(y)) return x;
+    return x * y / (x + y);
+  };
+  return ContactPair{std::min(a.mu, b.mu), series(a.stiffness, b.stiffness),
+                     series(a.damping, b.damping)};
+}
+
+Divisors divisors(const Rates& r) {
+  return Divisors{r.servo / r.haptic, r.servo / r.physics};
+}
+
+Vec3 box_inertia(double m, const Vec3& h) {
+  const Vec3 s = h.cwiseProduct(h);
+  return Vec3(m / 3.0 * (s.y() + s.z()), m / 3.0 * (s.x() + s.z()), m / 3.0 * (s.x() + s.y()));
+}
+
+void validate(const Model& model) {
+  const Rates& r = model.rates;
+  if (r.servo <= 0) fail("rates.servo", "must be a positive number of Hz (got " + std::to_string(r.servo) + ")");
+  if (r.haptic <= 0) fail("rates.haptic", "must be a positive number of Hz (got " + std::to_string(r.haptic) + ")");
+  if (r.physics <= 0) fail("rates.physics", "must be a positive number of Hz (got " + std::to_string(r.physics) + ")");
+  if (r.servo % r.haptic != 0)
+    fail("rates.haptic", std::to_string(r.haptic) + " Hz does not divide rates.servo = " + std::to_string(r.servo) + " Hz");
+  if (r.servo % r.physics != 0)
+    fail("rates.physics", std::to_string(r.physics) + " Hz does not divide rates.servo = " + std::to_string(r.servo) + " Hz");
+  if (!finite(model.gravity)) fail("gravity", "must be finite");
+  if (model.floor.enabled) {
+    check_material("floor.material", model.floor.material);
+    if (!std::isfinite(model.floor.height)) fail("floor.height", "must be finite");
+  }
+  std::set<std::string> names;
+  for (std::size_t i = 0; i < model.bodies.size(); ++i) {
+    const BodyParams& b = model.bodies[i];
+    const std::string f = "objects[" + std::to_string(i + 1) + "] '" + b.name + "'";
+    if (b.name.empty()) fail(f, "name must not be empty");
+    if (!names.insert(b.name).second) fail(f, "name '" + b.name + "' is used twice");
+    if (!(b.half_extents.minCoeff() > 0.0) || !finite(b.half_extents)) fail(f + ".size", "every side must be > 0 m and finite");
+    if (!(b.mass > 0.0) || std::isinf(b.mass)) fail(f + ".mass", "must be > 0 kg and finite (got " + str(b.mass) + ")");
+    const Vec3& j = b.inertia;
+    if (!(j.minCoeff() > 0.0) || !finite(j)) fail(f + ".inertia", "principal moments must be > 0 kg m^2");
+    // A physical body's principal moments obey the triangle inequality J_a + J_b >= J_c.
+    const double slack = 1e-12 * j.sum();
+    if (j.x() + j.y() < j.z() - slack || j.y() + j.z() < j.x() - slack || j.x() + j.z() < j.y() - slack)
+      fail(f + ".inertia", "principal moments break the triangle inequality (no real body has them)");
+    check_material(f + ".material", b.material);
+    if (!finite(b.position) || !finite(b.velocity) || !finite(b.angular_velocity) || !b.orientation.coeffs().allFinite())
+      fail(f, "initial position, orientation and velocities must be finite");
+    if (std::abs(b.orientation.norm() - 1.0) > 1e-9) fail(f + ".orientation", "must be a unit quaternion");
+    if (model.floor.enabled && std::isinf(contact_pair(b.material, model.floor.material).stiffness))
+      fail(f + ".material.stiffness", "the object and the floor are both rigid (infinite stiffness); "
+           "the penalty floor contact needs a finite stiffness on one of them");
+  }
+  names.clear();
+  for (std::size_t i = 0; i < model.fingers.size(); ++i) {
+    const FingerParams& p = model.fingers[i];
+    const std::string f = "fingers[" + std::to_string(i + 1) + "] '" + p.name + "'";
+    if (p.name.empty()) fail(f, "name must not be empty");
+    if (!names.insert(p.name).second) fail(f, "name '" + p.name + "' is used twice");
+    if (!(p.stiffness > 0.0) || std::isinf(p.stiffness)) fail(f + ".stiffness", "must be > 0 N/m and finite (got " + str(p.stiffness) + ")");
+    if (!(p.damping >= 0.0) || std::isinf(p.damping)) fail(f + ".damping", "must be >= 0 N s/m and finite (got " + str(p.damping) + ")");
+  }
+}
+
+}  // namespace graspsim

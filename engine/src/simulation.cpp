@@ -1,0 +1,93 @@
+// The tick: devices, finger contact, forces, physics, in one fixed order.
+#include "graspsim/engine/simulation.hpp"
+
+#include "graspsim/engine/finger_contact.hpp"
+#include "graspsim/engine/integrate.hpp"
+#include "graspsim/engine/object_contact.hpp"
+
+namespace graspsim {
+
+namespace {
+Model validated(Model model) {
+  validate(model);
+  return model;
+}
+}  // namespace
+
+Simulation::Simulation(Model model)
+    : model_(validated(std::move(model))),
+      divisors_(graspsim::divisors(model_.rates)),
+      state_(initial_state(model_)),
+      collision_(model_) {
+  collision_.update(state_);
+  scratch_.reserve(model_.bodies.size());
+}
+
+void Simulation::step(const Input& input, TickRecord& record) {
+  const std::int64_t n = state_.tick;
+  const std::size_t fingers = model_.fingers.size();
+  record.tick = n;
+  record.haptic_ran = n % divisors_.haptic == 0;
+  record.physics_ran = n % divisors_.physics == 0;
+
+  // 2 haptic: the friction cone algorithm per finger.
+  if (record.haptic_ran) {
+    for (std::size_t f = 0; f < fingers; ++f) {
+      finger_haptic_step(model_, state_, collision_, static_cast<int>(f), input.fingers[f].hip,
+                         state_.fingers[f], record.haptic[f], scratch_);
+    }
+  }
+
+  // 3 servo: force on each finger from the newest HIP; the reaction acts on the body at the GO.
+  for (std::size_t f = 0; f < fingers; ++f) {
+    const Vec3& hip = input.fingers[f].hip;
+    Vec3 go_world;
+    const Vec3 force = finger_force(model_, state_, static_cast<int>(f), hip, go_world);
+    record.servo[f].hip = hip;
+    record.servo[f].force = force;
+    if (record.haptic_ran) record.haptic[f].force = force;   // the haptic row shows the same force
+    state_.fingers[f].hip_at_last_servo = hip;
+    const int b = state_.fingers[f].body;
+    if (b >= 0) {
+      BodyState& bs = state_.bodies[b];
+      bs.window_force -= force;
+      bs.window_torque += (go_world - bs.position).cross(-force);
+    }
+  }
+  ++state_.window_ticks;
+
+  // 4 physics: residual wrench at each centre of mass, then integrate.
+  if (record.physics_ran) {
+    const double dt = 1.0 / model_.rates.physics;
+    // Impulse-consistent: the finger wrench is the mean over the servo ticks of the window.
+    const double per_tick = 1.0 / static_cast<double>(state_.window_ticks);
+    for (std::size_t b = 0; b < model_.bodies.size(); ++b) {
+      const BodyParams& bp = model_.bodies[b];
+      BodyState& bs = state_.bodies[b];
+      Wrench floor;
+      int floor_contacts = 0;
+      if (model_.floor.enabled) floor_contacts = floor_contact(model_, static_cast<int>(b), bs, floor);
+      const Vec3 force = bs.window_force * per_tick + floor.force + bp.mass * model_.gravity;
+      const Vec3 torque = bs.window_torque * per_tick + floor.torque;
+
+      BodyRecord& rec = record.physics[b];
+      rec.position = bs.position;
+      rec.orientation = quat_of(bs.rotation);
+      rec.velocity = bs.velocity;
+      rec.angular_velocity = bs.angular_velocity;
+      rec.force = force;
+      rec.torque = torque;
+      rec.floor_contacts = floor_contacts;
+
+      integrate_body(bp, bs, force, torque, dt);
+      bs.window_force.setZero();
+      bs.window_torque.setZero();
+    }
+    state_.window_ticks = 0;
+    collision_.update(state_);
+  }
+
+  ++state_.tick;
+}
+
+}  // namespace graspsim

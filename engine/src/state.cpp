@@ -1,0 +1,37 @@
+// The initial State and the sizing of per-tick records.
+#include "graspsim/engine/state.hpp"
+
+#include "graspsim/engine/record.hpp"
+
+namespace graspsim {
+
+State initial_state(const Model& model) {
+  State s;
+  s.bodies.resize(model.bodies.size());
+  for (std::size_t i = 0; i < model.bodies.size(); ++i) {
+    const BodyParams& p = model.bodies[i];
+    BodyState& b = s.bodies[i];
+    b.position = p.position;
+    b.rotation = p.orientation.normalized().toRotationMatrix();
+    b.velocity = p.velocity;
+    b.angular_velocity = p.angular_velocity;
+  }
+  s.fingers.resize(model.fingers.size());
+  return s;
+}
+
+TickRecord make_tick_record(const Model& model) {
+  TickRecord r;
+  r.servo.resize(model.fingers.size());
+  r.haptic.resize(model.fingers.size());
+  r.physics.resize(model.bodies.size());
+  return r;
+}
+
+Input make_input(const Model& model) {
+  Input in;
+  in.fingers.resize(model.fingers.size());
+  return in;
+}
+
+}  // namespace graspsim

@@ -1,0 +1,52 @@
+# Shared set-up for tools/graspsim and tools/check: install the Debian packages that are
+# missing, configure once, build incrementally. Sourced, not run; idempotent.
+# Environment: GRASPSIM_BUILD_DIR (default build), GRASPSIM_BUILD_TYPE (default Release).
+
+graspsim_root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
+graspsim_build=${GRASPSIM_BUILD_DIR:-$graspsim_root/build}
+
+# Everything graspsim needs from Debian 12, and nothing else.
+graspsim_packages=(
+  g++ make cmake pkg-config git
+  libeigen3-dev libfcl-dev liblua5.4-dev libhdf5-dev catch2
+  hdf5-tools python3 python3-h5py python3-matplotlib
+)
+
+graspsim_install_missing() {
+  local missing=() p
+  for p in "${graspsim_packages[@]}"; do
+    dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q 'install ok installed' \
+      || missing+=("$p")
+  done
+  [ ${#missing[@]} -eq 0 ] && return 0
+  echo "graspsim: installing missing Debian packages: ${missing[*]}" >&2
+  local sudo=()
+  if [ "$(id -u)" -ne 0 ]; then
+    command -v sudo >/dev/null || {
+      echo "graspsim: need root (or sudo) to install: ${missing[*]}" >&2; return 1; }
+    sudo=(sudo)
+  fi
+  "${sudo[@]}" env DEBIAN_FRONTEND=noninteractive apt-get update -qq >&2 &&
+    "${sudo[@]}" env DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends \
+      "${missing[@]}" >&2
+}
+
+graspsim_build() {
+  local jobs
+  jobs=$(nproc 2>/dev/null || echo 2)
+  if [ ! -f "$graspsim_build/CMakeCache.txt" ]; then
+    cmake -S "$graspsim_root" -B "$graspsim_build" \
+      -DCMAKE_BUILD_TYPE="${GRASPSIM_BUILD_TYPE:-Release}" >&2 || return 1
+  fi
+  # Build output goes to a log; on failure, show it. A quiet build keeps `graspsim run` readable.
+  local log="$graspsim_build/last-build.log"
+  if ! cmake --build "$graspsim_build" -j "$jobs" >"$log" 2>&1; then
+    cat "$log" >&2
+    echo "graspsim: build failed (log: $log)" >&2
+    return 1
+  fi
+}
+
+graspsim_setup() {
+  graspsim_install_missing && graspsim_build
+}
