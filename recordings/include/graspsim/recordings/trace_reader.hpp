@@ -1,0 +1,37 @@
+// Small helpers that read a trace back, one call per dataset or attribute (for tests and
+// tools; each call opens and closes the file).
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "graspsim/recordings/trace_writer.hpp"
+
+namespace graspsim::recordings {
+
+struct Dataset {
+  std::vector<double> values;       // row-major, converted to double (integers exact to 2^53)
+  std::vector<std::size_t> shape;   // (n,) or (n, width)
+  std::string units;                // the "units" attribute, "" if there is none
+  DType dtype = DType::kFloat64;    // on-disk type
+};
+
+// Reads a whole dataset ("/servo/time"). Throws TraceError naming the file and the path if the
+// file is not an HDF5 file, the path is missing or not a dataset, or its type is not one of DType.
+Dataset read_dataset(const std::string& file, const std::string& path);
+// Attribute `name` of the group or dataset `object_path` ("/" for the root).
+std::string read_string_attribute(const std::string& file, const std::string& object_path,
+                                  const std::string& name);
+std::int64_t read_int_attribute(const std::string& file, const std::string& object_path,
+                                const std::string& name);
+double read_double_attribute(const std::string& file, const std::string& object_path,
+                             const std::string& name);   // float or integer attribute
+bool has_attribute(const std::string& file, const std::string& object_path,
+                   const std::string& name);
+// Whether a group or dataset exists at `path` (false for a missing intermediate group too).
+// Throws TraceError if the file cannot be opened as HDF5.
+bool has_object(const std::string& file, const std::string& path);
+
+}  // namespace graspsim::recordings

@@ -1,0 +1,58 @@
+// TraceRecorder: maps the engine's per-tick records onto the trace schema (/servo, /haptic,
+// /physics; see recordings/README.md).
+#pragma once
+
+#include <cstddef>
+#include <vector>
+
+#include "graspsim/engine/math.hpp"
+#include "graspsim/engine/model.hpp"
+#include "graspsim/engine/record.hpp"
+#include "graspsim/recordings/trace_writer.hpp"
+
+namespace graspsim::recordings {
+
+class TraceRecorder {
+ public:
+  // Declares every table and column (and their attributes) in `writer`, which must outlive
+  // the recorder. Throws std::invalid_argument for a finger or object name that cannot be an
+  // HDF5 group name (empty, ".", "..", or containing '/').
+  TraceRecorder(TraceWriter& writer, const graspsim::Model& model);
+
+  // Appends one /servo row, plus a /haptic row if rec.haptic_ran and a /physics row if
+  // rec.physics_ran. `rendered` (one per finger): the force each device actually rendered after
+  // clamping (N, world). time = tick / servo rate, computed from the tick, never accumulated.
+  // Allocates nothing (after each table's first row). Throws std::invalid_argument if a record
+  // vector does not match the model's finger or body count.
+  void record(const graspsim::TickRecord& rec, const std::vector<graspsim::Vec3>& rendered);
+
+ private:
+  struct ServoColumns {
+    std::size_t hip;            // offset of fingers/<name>/hip
+    std::size_t force;          // offset of fingers/<name>/force
+    std::size_t force_demand;   // offset of fingers/<name>/force_demand
+  };
+  struct HapticColumns {
+    std::size_t god_object, surface_point, depth, friction_radius, force, state, body, slip;
+  };
+  struct PhysicsColumns {
+    std::size_t position, quaternion, velocity, angular_velocity, force, torque, floor_contacts;
+  };
+  struct TimeColumns {
+    std::size_t tick;   // offset of tick
+    std::size_t time;   // offset of time
+  };
+
+  TraceTable& servo_;
+  TraceTable& haptic_;
+  TraceTable& physics_;
+  double servo_rate_;   // Hz
+  TimeColumns servo_time_;
+  TimeColumns haptic_time_;
+  TimeColumns physics_time_;
+  std::vector<ServoColumns> servo_fingers_;     // Model::fingers order
+  std::vector<HapticColumns> haptic_fingers_;   // Model::fingers order
+  std::vector<PhysicsColumns> objects_;         // Model::bodies order
+};
+
+}  // namespace graspsim::recordings

@@ -1,0 +1,146 @@
+// TraceRecorder: one /servo row per servo tick, one /haptic and /physics row per tick of those
+// loops, with column offsets worked out once in the constructor.
+#include "graspsim/recordings/trace_recorder.hpp"
+
+#include <stdexcept>
+#include <string>
+
+namespace graspsim::recordings {
+namespace {
+
+void check_name(const std::string& what, const std::string& name) {
+  if (name.empty() || name == "." || name == ".." || name.find('/') != std::string::npos) {
+    throw std::invalid_argument("trace: " + what + " name '" + name +
+                                "' cannot be an HDF5 group name (empty, '.', '..' or has '/')");
+  }
+}
+
+void put(double* row, std::size_t offset, const Vec3& v) {
+  row[offset + 0] = v.x();
+  row[offset + 1] = v.y();
+  row[offset + 2] = v.z();
+}
+
+}  // namespace
+
+TraceRecorder::TraceRecorder(TraceWriter& writer, const graspsim::Model& model)
+    : servo_(writer.table("servo")),
+      haptic_(writer.table("haptic")),
+      physics_(writer.table("physics")),
+      servo_rate_(static_cast<double>(model.rates.servo)) {
+  for (const auto& f : model.fingers) check_name("finger", f.name);
+  for (const auto& b : model.bodies) check_name("object", b.name);
+
+  auto time_columns = [](TraceTable& t) {
+    TimeColumns c{};
+    c.tick = t.add_column("tick", 1, DType::kInt64, "tick");
+    c.time = t.add_column("time", 1, DType::kFloat64, "s");
+    return c;
+  };
+  servo_time_ = time_columns(servo_);
+  haptic_time_ = time_columns(haptic_);
+  physics_time_ = time_columns(physics_);
+
+  for (const auto& finger : model.fingers) {
+    const std::string p = "fingers/" + finger.name + "/";
+    ServoColumns s{};
+    s.hip = servo_.add_column(p + "hip", 3, DType::kFloat64, "m");
+    s.force = servo_.add_column(p + "force", 3, DType::kFloat64, "N");
+    s.force_demand = servo_.add_column(p + "force_demand", 3, DType::kFloat64, "N");
+    servo_fingers_.push_back(s);
+
+    HapticColumns h{};
+    h.god_object = haptic_.add_column(p + "god_object", 3, DType::kFloat64, "m");
+    h.surface_point = haptic_.add_column(p + "surface_point", 3, DType::kFloat64, "m");
+    h.depth = haptic_.add_column(p + "depth", 1, DType::kFloat64, "m");
+    h.friction_radius = haptic_.add_column(p + "friction_radius", 1, DType::kFloat64, "m");
+    h.force = haptic_.add_column(p + "force", 3, DType::kFloat64, "N");
+    h.state = haptic_.add_column(p + "state", 1, DType::kInt8, "1");
+    haptic_.set_attribute(p + "state", "values", "0 free, 1 stick, 2 slip");
+    h.body = haptic_.add_column(p + "body", 1, DType::kInt32, "1");
+    haptic_.set_attribute(p + "body", "values", "-1 none, -2 floor, k = objects[k]");
+    h.slip = haptic_.add_column(p + "slip", 1, DType::kFloat64, "m");
+    haptic_fingers_.push_back(h);
+  }
+  std::string bodies;
+  for (std::size_t k = 0; k < model.bodies.size(); ++k) {
+    bodies += (k > 0 ? "\n" : "") + model.bodies[k].name;
+  }
+  haptic_.set_attribute(".", "bodies", bodies);
+
+  for (const auto& body : model.bodies) {
+    const std::string p = "objects/" + body.name + "/";
+    PhysicsColumns o{};
+    o.position = physics_.add_column(p + "position", 3, DType::kFloat64, "m");
+    o.quaternion = physics_.add_column(p + "quaternion", 4, DType::kFloat64, "1");
+    physics_.set_attribute(p + "quaternion", "order", "w, x, y, z");
+    o.velocity = physics_.add_column(p + "velocity", 3, DType::kFloat64, "m/s");
+    o.angular_velocity = physics_.add_column(p + "angular_velocity", 3, DType::kFloat64, "rad/s");
+    o.force = physics_.add_column(p + "force", 3, DType::kFloat64, "N");
+    o.torque = physics_.add_column(p + "torque", 3, DType::kFloat64, "N m");
+    o.floor_contacts = physics_.add_column(p + "floor_contacts", 1, DType::kInt32, "1");
+    objects_.push_back(o);
+  }
+}
+
+void TraceRecorder::record(const graspsim::TickRecord& rec,
+                           const std::vector<graspsim::Vec3>& rendered) {
+  const std::size_t fingers = servo_fingers_.size();
+  if (rec.servo.size() != fingers || rendered.size() != fingers ||
+      (rec.haptic_ran && rec.haptic.size() != fingers) ||
+      (rec.physics_ran && rec.physics.size() != objects_.size())) {
+    throw std::invalid_argument("TraceRecorder::record: record sizes do not match the model");
+  }
+  const double tick = static_cast<double>(rec.tick);
+  const double time = tick / servo_rate_;   // s, from the tick, never accumulated
+
+  double* row = servo_.append_row();
+  row[servo_time_.tick] = tick;
+  row[servo_time_.time] = time;
+  for (std::size_t i = 0; i < fingers; ++i) {
+    const ServoColumns& c = servo_fingers_[i];
+    put(row, c.hip, rec.servo[i].hip);
+    put(row, c.force, rendered[i]);
+    put(row, c.force_demand, rec.servo[i].force);
+  }
+
+  if (rec.haptic_ran) {
+    row = haptic_.append_row();
+    row[haptic_time_.tick] = tick;
+    row[haptic_time_.time] = time;
+    for (std::size_t i = 0; i < fingers; ++i) {
+      const HapticColumns& c = haptic_fingers_[i];
+      const HapticFingerRecord& h = rec.haptic[i];
+      put(row, c.god_object, h.god_object);
+      put(row, c.surface_point, h.surface_point);
+      row[c.depth] = h.depth;
+      row[c.friction_radius] = h.friction_radius;
+      put(row, c.force, h.force);
+      row[c.state] = static_cast<double>(static_cast<int>(h.phase));
+      row[c.body] = static_cast<double>(h.body);
+      row[c.slip] = h.slip;
+    }
+  }
+
+  if (rec.physics_ran) {
+    row = physics_.append_row();
+    row[physics_time_.tick] = tick;
+    row[physics_time_.time] = time;
+    for (std::size_t k = 0; k < objects_.size(); ++k) {
+      const PhysicsColumns& c = objects_[k];
+      const BodyRecord& b = rec.physics[k];
+      put(row, c.position, b.position);
+      row[c.quaternion + 0] = b.orientation.w();
+      row[c.quaternion + 1] = b.orientation.x();
+      row[c.quaternion + 2] = b.orientation.y();
+      row[c.quaternion + 3] = b.orientation.z();
+      put(row, c.velocity, b.velocity);
+      put(row, c.angular_velocity, b.angular_velocity);
+      put(row, c.force, b.force);
+      put(row, c.torque, b.torque);
+      row[c.floor_contacts] = static_cast<double>(b.floor_contacts);
+    }
+  }
+}
+
+}  // namespace graspsim::recordings
