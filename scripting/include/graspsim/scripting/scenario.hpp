@@ -1,0 +1,120 @@
+// A scenario loaded from Lua: the engine Model, each finger's device set-up, the run's duration
+// and seed, and the expectations the run checks. The only place that converts between Lua
+// values and C++ types is scripting/src/lua_convert.cpp.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "graspsim/engine/model.hpp"
+#include "graspsim/hw/device.hpp"
+#include "graspsim/hw/trajectory.hpp"
+#include "graspsim/scripting/error.hpp"        // ScenarioError
+#include "graspsim/scripting/lua_sandbox.hpp"  // SandboxLimits
+
+namespace graspsim::scripting {
+
+class LuaSandbox;
+
+// What a finger is driven by when nothing on the command line overrides it.
+struct FingerSetup {
+  hw::DeviceLimits limits;   // clamp for rendered forces
+};
+
+// One expectation about the outcome: a Lua function checked at time `at`.
+struct Expectation {
+  std::string what;     // the sentence the scenario gave, e.g. "box lifted at least 5 cm"
+  double at = -1.0;     // s: when to check; < 0 means at the end of the run
+  int function_ref = 0; // registry reference of the Lua check function (owned by the sandbox)
+};
+
+struct ExpectationResult {
+  std::string what;
+  bool passed = false;
+  std::string detail;   // the message the check function returned, if any
+};
+
+// What the expectation functions see of the simulation (plain data, filled by the runner).
+struct ObjectSnapshot {
+  std::string name;
+  Vec3 position{0.0, 0.0, 0.0};           // m, world
+  Quat orientation = Quat::Identity();    // 1, body to world
+  Vec3 velocity{0.0, 0.0, 0.0};           // m/s
+  Vec3 angular_velocity{0.0, 0.0, 0.0};   // rad/s, world
+  int floor_contacts = 0;                 // 1
+};
+struct FingerSnapshot {
+  std::string name;
+  Vec3 hip{0.0, 0.0, 0.0};          // m, world
+  Vec3 god_object{0.0, 0.0, 0.0};   // m, world
+  Vec3 force{0.0, 0.0, 0.0};        // N, world, on the finger (last haptic tick)
+  std::string touching;             // name of the contacted object, "floor" or "" (free)
+  double slip = 0.0;                // m: total distance its god-object slid over surfaces so far
+};
+struct Snapshot {
+  double time = 0.0;   // s
+  std::vector<ObjectSnapshot> objects;   // Model::bodies order
+  std::vector<FingerSnapshot> fingers;   // Model::fingers order
+};
+
+struct LoadOptions {
+  // "--set name=value" overrides, applied to the scenario table before it is converted.
+  std::vector<std::string> sets;
+  // Memory limit and instruction budgets of the Lua state the scenario runs in.
+  SandboxLimits limits;
+};
+
+class Scenario {
+ public:
+  // Loads, runs (sandboxed, with an instruction budget) and converts a scenario file.
+  // Throws ScenarioError with a message naming the file and line or the field.
+  static Scenario load(const std::string& path, const LoadOptions& options = {});
+
+  Scenario(Scenario&&) noexcept;
+  Scenario& operator=(Scenario&&) noexcept;
+  ~Scenario();
+
+  const std::string& path() const { return path_; }
+  const std::string& source() const { return source_; }   // the file's text, for the trace
+  const std::string& name() const { return name_; }
+  const std::string& description() const { return description_; }
+  const Model& model() const { return model_; }
+  double duration() const { return duration_; }              // s
+  std::uint64_t seed() const { return seed_; }
+  const std::vector<FingerSetup>& fingers() const { return fingers_; }
+  const std::vector<Expectation>& expectations() const { return expectations_; }
+  // Every parameter after overrides, as sorted "path = value" lines, for the trace.
+  const std::vector<std::string>& parameters() const { return parameters_; }
+
+  // The scripted trajectory of finger i (waypoints, or a Lua function of time). Lua errors while
+  // it runs are thrown as ScenarioError with file:line and a traceback.
+  std::unique_ptr<hw::Trajectory> make_trajectory(std::size_t finger) const;
+
+  // Checks expectation i against `now` (and `initial`, the snapshot at t = 0).
+  ExpectationResult check(std::size_t expectation, const Snapshot& now,
+                          const Snapshot& initial) const;
+
+ private:
+  Scenario();
+  std::string path_, source_, name_, description_;
+  Model model_;
+  double duration_ = 0.0;
+  std::uint64_t seed_ = 0;
+  std::vector<FingerSetup> fingers_;
+  std::vector<Expectation> expectations_;
+  std::vector<std::string> parameters_;
+  // Finger trajectories: waypoints, or a registry ref to a Lua function (0 when waypoints).
+  struct TrajectorySpec {
+    std::vector<hw::Waypoint> waypoints;
+    hw::Interpolation interpolation = hw::Interpolation::kMinimumJerk;
+    int function_ref = 0;
+  };
+  std::vector<TrajectorySpec> trajectories_;
+  std::unique_ptr<LuaSandbox> lua_;   // owns the Lua state the functions live in
+  friend class ScenarioBuilder;
+};
+
+}  // namespace graspsim::scripting

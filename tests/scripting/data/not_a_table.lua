@@ -1,0 +1,2 @@
+-- A scenario that forgets to return its table.
+local scenario = { duration = 1 }
