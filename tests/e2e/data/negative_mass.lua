@@ -1,0 +1,1 @@
+return { duration = 1.0, objects = { { name = "box", size = { 1, 1, 1 }, mass = -1 } } }

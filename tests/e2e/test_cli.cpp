@@ -1,0 +1,94 @@
+// The graspsim command line as a user meets it: help, exit codes, and a clear message naming
+// the file and line or the field for every kind of bad input.
+#include <catch2/catch.hpp>
+
+#include <cstdio>
+#include <string>
+#include <sys/wait.h>
+
+#include "graspsim/recordings/trace_reader.hpp"
+
+namespace {
+
+const std::string kCli = GRASPSIM_CLI;
+const std::string kData = std::string(GRASPSIM_SOURCE_DIR) + "/tests/e2e/data/";
+const std::string kTmp = GRASPSIM_TEST_TMP;
+
+struct Outcome {
+  int status;           // exit status
+  std::string output;   // stdout and stderr together
+};
+
+Outcome cli(const std::string& args) {
+  const std::string command = kCli + " " + args + " 2>&1";
+  FILE* pipe = popen(command.c_str(), "r");
+  REQUIRE(pipe);
+  std::string out;
+  char buf[4096];
+  while (std::size_t n = std::fread(buf, 1, sizeof buf, pipe)) out.append(buf, n);
+  const int raw = pclose(pipe);
+  return Outcome{WIFEXITED(raw) ? WEXITSTATUS(raw) : -1, out};
+}
+
+}  // namespace
+
+TEST_CASE("graspsim --help explains the command and exits 0", "[cli]") {
+  const Outcome o = cli("--help");
+  CHECK(o.status == 0);
+  CHECK_THAT(o.output, Catch::Contains("graspsim run SCENARIO.lua"));
+  CHECK_THAT(o.output, Catch::Contains("--set NAME=VALUE"));
+  CHECK_THAT(o.output, Catch::Contains("exit status"));
+  CHECK(cli("run --help").status == 0);
+}
+
+// Each bad input ends with exit status 2 and a message that names the problem: the file and
+// line for Lua errors, the field for bad values.
+TEST_CASE("bad input gives exit status 2 and names the problem", "[cli][bad_input]") {
+  const std::string out = " --out " + kTmp + "/cli_bad.h5";
+  struct Case { std::string args; std::vector<std::string> says; };
+  const std::vector<Case> cases = {
+      {"", {"usage"}},
+      {"fly", {"unknown command 'fly'"}},
+      {"run", {"needs a scenario"}},
+      {"run " + kData + "nowhere.lua" + out, {"cannot open scenario", "nowhere.lua"}},
+      {"run " + kData + "syntax.lua" + out, {"syntax.lua:3:"}},
+      {"run " + kData + "runtime.lua" + out, {"runtime.lua:4:", "traceback"}},
+      {"run " + kData + "misspelled.lua" + out, {"misspelled.lua", "'mas'", "mass"}},
+      {"run " + kData + "negative_mass.lua" + out, {"negative_mass.lua", "mass", "> 0"}},
+      {"run " + kData + "negative_mu.lua" + out, {"negative_mu.lua", "mu", ">= 0"}},
+      {"run " + kData + "bad_rate.lua" + out, {"bad_rate.lua", "rates.haptic", "does not divide"}},
+      {"run " + kData + "endless.lua" + out, {"endless.lua", "instruction budget"}},
+      {"run " + kData + "fails_expectation.lua --out /nonexistent-dir/x.h5", {"/nonexistent-dir/x.h5"}},
+      {"run " + kData + "fails_expectation.lua --bogus", {"unknown option '--bogus'"}},
+      {"run " + kData + "fails_expectation.lua --duration -1", {"--duration"}},
+      {"run " + kData + "fails_expectation.lua --set", {"--set needs NAME=VALUE"}},
+      {"run " + kData + "fails_expectation.lua --set objects.box.mas=1" + out, {"'mas'"}},
+  };
+  for (const Case& c : cases) {
+    const Outcome o = cli(c.args);
+    INFO("graspsim " << c.args << "\n" << o.output);
+    CHECK(o.status == 2);
+    for (const std::string& s : c.says) CHECK_THAT(o.output, Catch::Contains(s));
+  }
+}
+
+TEST_CASE("a failed expectation gives exit status 1 and says which", "[cli]") {
+  const Outcome o = cli("run " + kData + "fails_expectation.lua --out " + kTmp + "/cli_fail.h5");
+  INFO(o.output);
+  CHECK(o.status == 1);
+  CHECK_THAT(o.output, Catch::Contains("FAIL  the box stays up"));
+}
+
+// A script error in the middle of a run stops it with status 2, names the line, and keeps the
+// trace of everything before, marked with the error (at 0.5 s: 1500 servo rows).
+TEST_CASE("a run that fails midway keeps its trace, marked with the error", "[cli][trace]") {
+  const std::string trace = kTmp + "/cli_midway.h5";
+  const Outcome o = cli("run " + kData + "error_midway.lua --out " + trace);
+  INFO(o.output);
+  CHECK(o.status == 2);
+  CHECK_THAT(o.output, Catch::Contains("error_midway.lua:8:"));
+  CHECK_THAT(o.output, Catch::Contains("the hand slipped off the script"));
+  const std::string status = graspsim::recordings::read_string_attribute(trace, "/", "status");
+  CHECK_THAT(status, Catch::StartsWith("error:") && Catch::Contains("the hand slipped"));
+  CHECK(graspsim::recordings::read_dataset(trace, "/servo/tick").shape.at(0) == 1500);
+}

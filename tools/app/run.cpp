@@ -1,0 +1,201 @@
+// The run loop: devices -> engine -> devices, trace every tick, check expectations on time.
+#include "app/run.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <memory>
+#include <sstream>
+
+#include "graspsim/engine/simulation.hpp"
+#include "graspsim/hw/scripted_finger.hpp"
+#include "graspsim/recordings/trace_recorder.hpp"
+#include "graspsim/recordings/trace_writer.hpp"
+
+#ifndef GRASPSIM_VERSION
+#define GRASPSIM_VERSION "unknown"
+#endif
+#ifndef GRASPSIM_BUILD_FLAGS
+#define GRASPSIM_BUILD_FLAGS "unknown"
+#endif
+
+namespace graspsim::app {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+std::string body_name(const Model& model, int body) {
+  if (body >= 0) return model.bodies[body].name;
+  return body == kFloor ? "floor" : "";
+}
+
+// What the scenario's expectation functions see.
+scripting::Snapshot snapshot(const Simulation& sim, const TickRecord& last,
+                             const std::vector<double>& slip) {
+  const Model& model = sim.model();
+  const State& state = sim.state();
+  scripting::Snapshot s;
+  s.time = sim.time();
+  for (std::size_t b = 0; b < model.bodies.size(); ++b) {
+    const BodyState& bs = state.bodies[b];
+    scripting::ObjectSnapshot o;
+    o.name = model.bodies[b].name;
+    o.position = bs.position;
+    o.orientation = quat_of(bs.rotation);
+    o.velocity = bs.velocity;
+    o.angular_velocity = bs.angular_velocity;
+    o.floor_contacts = last.physics[b].floor_contacts;
+    s.objects.push_back(std::move(o));
+  }
+  for (std::size_t f = 0; f < model.fingers.size(); ++f) {
+    scripting::FingerSnapshot fs;
+    fs.name = model.fingers[f].name;
+    fs.hip = last.servo[f].hip;
+    fs.force = last.servo[f].force;
+    fs.god_object = last.haptic[f].god_object;
+    fs.touching = body_name(model, state.fingers[f].body);
+    fs.slip = slip[f];
+    s.fingers.push_back(std::move(fs));
+  }
+  return s;
+}
+
+std::string join_lines(const std::vector<std::string>& lines) {
+  std::string out;
+  for (const std::string& l : lines) out += l + "\n";
+  return out;
+}
+
+}  // namespace
+
+bool RunResult::passed() const {
+  return error.empty() &&
+         std::all_of(expectations.begin(), expectations.end(), [](const auto& e) { return e.passed; });
+}
+
+RunResult run_scenario(const scripting::Scenario& scenario, const RunOptions& options) {
+  const Model& model = scenario.model();
+  RunResult result;
+  result.trace_path = options.out.empty() ? scenario.name() + ".h5" : options.out;
+
+  recordings::TraceOptions trace_options;
+  trace_options.block_rows = options.block_rows;
+  trace_options.compression = options.compression;
+  recordings::TraceWriter writer(result.trace_path, trace_options);   // throws if it cannot
+
+  // The file explains and replays itself: the scenario text, every parameter, rates, seed, build.
+  writer.set_attribute("schema_version", std::int64_t{1});
+  writer.set_attribute("scenario_path", scenario.path());
+  writer.set_attribute("scenario_name", scenario.name());
+  writer.set_attribute("scenario_source", scenario.source());
+  writer.set_attribute("parameters", join_lines(scenario.parameters()));
+  writer.set_attribute("rate_servo", std::int64_t{model.rates.servo});
+  writer.set_attribute("rate_haptic", std::int64_t{model.rates.haptic});
+  writer.set_attribute("rate_physics", std::int64_t{model.rates.physics});
+  writer.set_attribute("seed", static_cast<std::int64_t>(scenario.seed()));
+  writer.set_attribute("duration", scenario.duration());
+  writer.set_attribute("graspsim_version", GRASPSIM_VERSION);
+  writer.set_attribute("compiler", std::string("g++ ") + __VERSION__);
+  writer.set_attribute("build_flags", GRASPSIM_BUILD_FLAGS);
+
+  std::vector<std::unique_ptr<hw::Device>> devices;
+  std::vector<double> slip(model.fingers.size(), 0.0);
+  const auto release_all = [&devices] {
+    for (auto& d : devices) d->release();
+  };
+  const auto start = Clock::now();
+  try {
+    std::ostringstream device_list;
+    for (std::size_t f = 0; f < model.fingers.size(); ++f) {
+      devices.push_back(std::make_unique<hw::ScriptedFinger>(scenario.make_trajectory(f),
+                                                             scenario.fingers()[f].limits));
+      device_list << model.fingers[f].name << ": " << devices.back()->describe()
+                  << " (max force " << devices.back()->limits().max_force << " N)\n";
+    }
+    writer.set_attribute("devices", device_list.str());
+
+    Simulation sim(model);
+    recordings::TraceRecorder recorder(writer, model);
+    Input input = make_input(model);
+    TickRecord record = make_tick_record(model);
+    std::vector<Vec3> rendered(model.fingers.size(), Vec3::Zero());
+    const auto ticks = static_cast<std::int64_t>(std::llround(scenario.duration() * model.rates.servo));
+
+    // Expectations in the order they fall due: (tick, index), so ties keep the scenario's order.
+    std::vector<std::pair<std::int64_t, std::size_t>> due;
+    for (std::size_t i = 0; i < scenario.expectations().size(); ++i) {
+      const double at = scenario.expectations()[i].at;
+      const std::int64_t tick = at < 0.0 ? ticks : std::min<std::int64_t>(ticks, std::llround(at * model.rates.servo));
+      due.emplace_back(tick, i);
+    }
+    std::sort(due.begin(), due.end());
+    for (const auto& e : scenario.expectations())
+      result.expectations.push_back({e.what, false, "not checked: the run stopped before it was due"});
+    std::size_t next_due = 0;
+    scripting::Snapshot initial;
+    const auto check_due = [&](std::int64_t tick) {
+      while (next_due < due.size() && due[next_due].first == tick) {
+        const std::size_t i = due[next_due].second;
+        result.expectations[i] = scenario.check(i, snapshot(sim, record, slip), initial);
+        ++next_due;
+      }
+    };
+
+    auto last_progress = start;
+    for (std::int64_t n = 0; n < ticks; ++n) {
+      const double t = sim.time();
+      for (std::size_t f = 0; f < devices.size(); ++f) input.fingers[f].hip = devices[f]->read(n, t).position;
+      if (n == 0) {
+        // Before the first step no finger record exists yet: a finger is where its device is.
+        for (std::size_t f = 0; f < devices.size(); ++f) record.servo[f].hip = record.haptic[f].god_object = input.fingers[f].hip;
+        initial = snapshot(sim, record, slip);
+      }
+      check_due(n);
+      sim.step(input, record);
+      for (std::size_t f = 0; f < devices.size(); ++f) rendered[f] = devices[f]->render(record.servo[f].force);
+      recorder.record(record, rendered);
+      ++result.servo_ticks;
+      if (record.haptic_ran) {
+        ++result.haptic_ticks;
+        for (std::size_t f = 0; f < slip.size(); ++f) slip[f] += record.haptic[f].slip;
+      }
+      result.physics_ticks += record.physics_ran;
+      // Wall-clock checks only every 3000 ticks: they are the only clock reads in the loop.
+      if (n % 3000 == 2999) {
+        if (options.interrupt && options.interrupt->load()) {
+          result.interrupted = true;
+          throw std::runtime_error("interrupted at t = " + std::to_string(sim.time()) + " s");
+        }
+        if (options.progress && seconds_since(last_progress) > 0.25) {
+          last_progress = Clock::now();
+          options.progress(sim.time(), scenario.duration());
+        }
+      }
+    }
+    if (ticks == 0) initial = snapshot(sim, record, slip);
+    check_due(ticks);
+    result.simulated = sim.time();
+  } catch (const std::exception& e) {
+    result.error = e.what();
+  }
+  release_all();
+  result.wall = seconds_since(start);
+
+  std::ostringstream summary;
+  for (const auto& e : result.expectations) {
+    summary << (e.passed ? "PASS " : "FAIL ") << e.what << (e.detail.empty() ? "" : ": " + e.detail) << "\n";
+  }
+  try {
+    writer.set_attribute("expectations", summary.str());
+    writer.close(result.error.empty() ? "complete" : "error: " + result.error);
+  } catch (const std::exception& e) {
+    if (result.error.empty()) result.error = std::string("writing the trace: ") + e.what();
+  }
+  return result;
+}
+
+}  // namespace graspsim::app

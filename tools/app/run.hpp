@@ -1,0 +1,41 @@
+// Running a scenario: devices feed the engine tick by tick, every tick is traced, and the
+// scenario's expectations are checked at their times. Lives outside engine/ because it owns the
+// wall clock (for the real-time factor and the progress line), the devices and the trace.
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "graspsim/scripting/scenario.hpp"
+
+namespace graspsim::app {
+
+struct RunOptions {
+  std::string out;                  // trace path; "" means "<scenario name>.h5" in the working directory
+  std::size_t block_rows = 1024;    // trace rows buffered per loop before a write
+  int compression = 0;              // 0 none, 1..9 deflate level
+  // Called about every 0.25 s of wall time with the simulated time reached (s); may be empty.
+  std::function<void(double simulated, double duration)> progress;
+  const std::atomic<bool>* interrupt = nullptr;   // set (by a signal handler) to stop the run
+};
+
+struct RunResult {
+  std::string trace_path;
+  std::vector<scripting::ExpectationResult> expectations;
+  std::int64_t servo_ticks = 0, haptic_ticks = 0, physics_ticks = 0;
+  double simulated = 0.0;   // s
+  double wall = 0.0;        // s
+  std::string error;        // non-empty when the run stopped early (Lua error, interrupt, ...)
+  bool interrupted = false;
+  bool passed() const;      // no error and every expectation met
+};
+
+// Runs the scenario to its end (or to an error), writing the trace. Throws only when the trace
+// cannot be created (recordings::TraceError); every later failure ends the run, closes the trace
+// with status "error: ...", sets every device's force to zero, and is reported in RunResult.
+RunResult run_scenario(const scripting::Scenario& scenario, const RunOptions& options);
+
+}  // namespace graspsim::app

@@ -1,0 +1,210 @@
+// The graspsim command line: run a scenario, write its trace, report its expectations.
+#include <atomic>
+#include <csignal>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <cmath>
+#include <iostream>
+#include <optional>
+#include <string>
+#include <unistd.h>
+#include <vector>
+
+#include "app/run.hpp"
+#include "graspsim/recordings/trace_writer.hpp"
+#include "graspsim/scripting/scenario.hpp"
+
+#ifndef GRASPSIM_VERSION
+#define GRASPSIM_VERSION "unknown"
+#endif
+
+namespace {
+
+// Exit codes, as documented in --help.
+constexpr int kExitOk = 0;            // every expectation held
+constexpr int kExitFailed = 1;        // an expectation failed
+constexpr int kExitBadInput = 2;      // bad input: arguments, scenario, output path, script error
+constexpr int kExitInterrupted = 130; // Ctrl-C (128 + SIGINT)
+
+constexpr const char* kUsage =
+    "usage: graspsim run SCENARIO.lua [--out FILE.h5] [--duration S] [--set NAME=VALUE]...\n"
+    "       graspsim --help | --version\n";
+
+constexpr const char* kHelp =
+    "graspsim: a deterministic multi-rate simulator of multi-finger haptic grasping\n"
+    "(after Melder, Harwin & Sharkey: god-objects with friction cones, residual force and\n"
+    "torque, penalty object contact).\n"
+    "\n"
+    "usage: graspsim run SCENARIO.lua [options]\n"
+    "\n"
+    "Runs a Lua scenario to its end, writes every tick of every loop (servo, haptic, physics)\n"
+    "to an HDF5 trace, and checks the scenario's expectations.\n"
+    "\n"
+    "options:\n"
+    "  --out FILE.h5        trace file (default: <scenario name>.h5 in this directory)\n"
+    "  --duration S         simulated seconds, overriding the scenario's duration\n"
+    "  --set NAME=VALUE     override a scenario value, e.g. --set rates.physics=500,\n"
+    "                       --set objects.box.mass=0.5, --set fingers.thumb.stiffness=600,\n"
+    "                       --set gravity=0,0,-1.62, or a param() the scenario declares\n"
+    "  --compress N         deflate the trace at level N (1..9; default none)\n"
+    "  --quiet              print only errors and failed expectations\n"
+    "  -h, --help           this help\n"
+    "  --version            the build's version\n"
+    "\n"
+    "exit status: 0 every expectation held, 1 an expectation failed, 2 bad input (arguments,\n"
+    "scenario, output path, or an error in the script while it ran), 130 interrupted.\n"
+    "A run that stops early keeps its trace, with root attribute status = \"error: ...\".\n";
+
+std::atomic<bool> g_interrupt{false};
+extern "C" void on_sigint(int) { g_interrupt.store(true); }
+
+int bad_input(const std::string& message) {
+  std::cerr << "graspsim: " << message << "\n";
+  return kExitBadInput;
+}
+
+std::string human_bytes(std::uintmax_t n) {
+  char buf[32];
+  if (n >= 1024 * 1024) std::snprintf(buf, sizeof buf, "%.1f MB", n / (1024.0 * 1024.0));
+  else std::snprintf(buf, sizeof buf, "%.1f kB", n / 1024.0);
+  return buf;
+}
+
+bool parse_number(const std::string& text, double& out) {
+  char* end = nullptr;
+  out = std::strtod(text.c_str(), &end);
+  return !text.empty() && end && *end == '\0' && std::isfinite(out);
+}
+
+int run_command(const std::vector<std::string>& args) {
+  std::string scenario_path, out;
+  graspsim::scripting::LoadOptions load;
+  int compression = 0;
+  bool quiet = false;
+  for (std::size_t i = 0; i < args.size(); ++i) {
+    const std::string& a = args[i];
+    const auto value = [&](const char* flag) -> const std::string* {
+      if (i + 1 >= args.size()) return nullptr;
+      (void)flag;
+      return &args[++i];
+    };
+    if (a == "-h" || a == "--help") {
+      std::cout << kHelp;
+      return kExitOk;
+    } else if (a == "--out") {
+      const std::string* v = value("--out");
+      if (!v) return bad_input("--out needs a file name\n" + std::string(kUsage));
+      out = *v;
+    } else if (a == "--duration") {
+      const std::string* v = value("--duration");
+      double d = 0.0;
+      if (!v || !parse_number(*v, d) || !(d > 0.0))
+        return bad_input("--duration needs a positive number of seconds" + (v ? " (got '" + *v + "')" : std::string()));
+      load.sets.push_back("duration=" + *v);
+    } else if (a == "--set") {
+      const std::string* v = value("--set");
+      if (!v || v->find('=') == std::string::npos || v->front() == '=')
+        return bad_input("--set needs NAME=VALUE" + (v ? " (got '" + *v + "')" : std::string()));
+      load.sets.push_back(*v);
+    } else if (a == "--compress") {
+      const std::string* v = value("--compress");
+      double level = 0.0;
+      if (!v || !parse_number(*v, level) || level < 1 || level > 9 || level != std::floor(level))
+        return bad_input("--compress needs a level from 1 to 9");
+      compression = static_cast<int>(level);
+    } else if (a == "--quiet") {
+      quiet = true;
+    } else if (a.rfind("-", 0) == 0) {
+      return bad_input("unknown option '" + a + "'\n" + kUsage);
+    } else if (scenario_path.empty()) {
+      scenario_path = a;
+    } else {
+      return bad_input("one scenario at a time (got '" + scenario_path + "' and '" + a + "')");
+    }
+  }
+  if (scenario_path.empty()) return bad_input(std::string("run needs a scenario file\n") + kUsage);
+
+  std::optional<graspsim::scripting::Scenario> scenario;
+  try {
+    scenario.emplace(graspsim::scripting::Scenario::load(scenario_path, load));
+  } catch (const graspsim::scripting::ScenarioError& e) {
+    return bad_input(e.what());
+  }
+
+  graspsim::app::RunOptions options;
+  options.out = out;
+  options.compression = compression;
+  options.interrupt = &g_interrupt;
+  const bool tty = isatty(STDERR_FILENO) && !quiet;
+  if (tty) {
+    options.progress = [](double t, double duration) {
+      std::fprintf(stderr, "\r  running: %5.1f%%  t = %.2f of %.2f s", 100.0 * t / duration, t, duration);
+      std::fflush(stderr);
+    };
+  }
+  std::signal(SIGINT, on_sigint);
+
+  graspsim::app::RunResult result;
+  try {
+    result = graspsim::app::run_scenario(*scenario, options);
+  } catch (const graspsim::recordings::TraceError& e) {
+    return bad_input(std::string("cannot write the trace: ") + e.what());
+  }
+  if (tty) std::fprintf(stderr, "\r%60s\r", "");
+
+  const auto& model = scenario->model();
+  std::error_code ec;
+  const auto size = std::filesystem::file_size(result.trace_path, ec);
+  if (!quiet) {
+    std::printf("graspsim %s: %s\n", scenario->name().c_str(), scenario->path().c_str());
+    std::printf("  rates       %d / %d / %d Hz (servo / haptic / physics)\n", model.rates.servo,
+                model.rates.haptic, model.rates.physics);
+    std::printf("  simulated   %.3f s: %lld servo, %lld haptic, %lld physics ticks\n", result.simulated,
+                static_cast<long long>(result.servo_ticks), static_cast<long long>(result.haptic_ticks),
+                static_cast<long long>(result.physics_ticks));
+    std::printf("  wall time   %.3f s (%.1fx real time)\n", result.wall,
+                result.wall > 0 ? result.simulated / result.wall : 0.0);
+    std::printf("  trace       %s (%s)\n", result.trace_path.c_str(), ec ? "?" : human_bytes(size).c_str());
+  }
+  if (!result.error.empty()) {
+    std::fprintf(stderr, "graspsim: the run stopped early: %s\n  (the trace keeps every tick up to there)\n",
+                 result.error.c_str());
+  }
+  int failed = 0;
+  if (!result.expectations.empty() && !quiet) std::printf("  expectations\n");
+  for (const auto& e : result.expectations) {
+    failed += !e.passed;
+    if (quiet && e.passed) continue;
+    std::printf("    %s  %s%s%s\n", e.passed ? "PASS" : "FAIL", e.what.c_str(), e.detail.empty() ? "" : ": ",
+                e.detail.c_str());
+  }
+  if (result.interrupted) return kExitInterrupted;
+  if (!result.error.empty()) return kExitBadInput;
+  if (!quiet) {
+    if (failed) std::printf("  result      %d of %zu expectations failed\n", failed, result.expectations.size());
+    else std::printf("  result      all %zu expectations met\n", result.expectations.size());
+  }
+  return failed ? kExitFailed : kExitOk;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::vector<std::string> args(argv + 1, argv + argc);
+  if (args.empty()) {
+    std::cerr << kUsage << "Try 'graspsim --help'.\n";
+    return kExitBadInput;
+  }
+  const std::string command = args.front();
+  if (command == "-h" || command == "--help" || command == "help") {
+    std::cout << kHelp;
+    return kExitOk;
+  }
+  if (command == "--version") {
+    std::cout << "graspsim " << GRASPSIM_VERSION << "\n";
+    return kExitOk;
+  }
+  if (command == "run") return run_command({args.begin() + 1, args.end()});
+  return bad_input("unknown command '" + command + "'\n" + kUsage + "Try 'graspsim --help'.");
+}
