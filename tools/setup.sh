@@ -31,22 +31,29 @@ graspsim_install_missing() {
       "${missing[@]}" >&2
 }
 
+# graspsim_build [TARGET...]: configure once, then build the targets (default: everything).
 graspsim_build() {
   local jobs
   jobs=$(nproc 2>/dev/null || echo 2)
-  if [ ! -f "$graspsim_build/CMakeCache.txt" ]; then
-    cmake -S "$graspsim_root" -B "$graspsim_build" \
-      -DCMAKE_BUILD_TYPE="${GRASPSIM_BUILD_TYPE:-Release}" >&2 || return 1
-  fi
-  # Build output goes to a log; on failure, show it. A quiet build keeps `graspsim run` readable.
   local log="$graspsim_build/last-build.log"
-  if ! cmake --build "$graspsim_build" -j "$jobs" >"$log" 2>&1; then
+  mkdir -p "$graspsim_build" && : >"$log"
+  if [ ! -f "$graspsim_build/CMakeCache.txt" ]; then
+    echo "graspsim: first build, in $graspsim_build (a few minutes; log: $log)" >&2
+    cmake -S "$graspsim_root" -B "$graspsim_build" \
+      -DCMAKE_BUILD_TYPE="${GRASPSIM_BUILD_TYPE:-Release}" >>"$log" 2>&1 \
+      || { cat "$log" >&2; echo "graspsim: configuring failed (log: $log)" >&2; return 1; }
+  fi
+  local targets=()
+  [ $# -gt 0 ] && targets=(--target "$@")
+  # Build output goes to a log; on failure, show it. A quiet build keeps `graspsim run` readable.
+  if ! cmake --build "$graspsim_build" -j "$jobs" "${targets[@]}" >>"$log" 2>&1; then
     cat "$log" >&2
     echo "graspsim: build failed (log: $log)" >&2
     return 1
   fi
 }
 
+# graspsim_setup [TARGET...]
 graspsim_setup() {
-  graspsim_install_missing && graspsim_build
+  graspsim_install_missing && graspsim_build "$@"
 }
