@@ -26,9 +26,18 @@ graspsim_install_missing() {
       echo "graspsim: need root (or sudo) to install: ${missing[*]}" >&2; return 1; }
     sudo=(sudo)
   fi
-  "${sudo[@]}" env DEBIAN_FRONTEND=noninteractive apt-get update -qq >&2 &&
-    "${sudo[@]}" env DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends \
-      "${missing[@]}" >&2
+  # apt's progress goes to a log, shown only when something fails.
+  local log
+  log=$(mktemp /tmp/graspsim-apt.XXXXXX.log)
+  if "${sudo[@]}" env DEBIAN_FRONTEND=noninteractive apt-get update -qq >"$log" 2>&1 &&
+     "${sudo[@]}" env DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends \
+       "${missing[@]}" >>"$log" 2>&1; then
+    rm -f "$log"
+  else
+    cat "$log" >&2
+    echo "graspsim: installing ${missing[*]} failed (log: $log)" >&2
+    return 1
+  fi
 }
 
 # graspsim_build [TARGET...]: configure once, then build the targets (default: everything).
