@@ -11,14 +11,16 @@
 --
 -- The floor is the paper's penalty contact at the paper's 50 Hz physics rate. To be stable at
 -- 50 Hz it must be soft: the box's rocking mode needs h^2 K / I < 4 - 2 h C / I, which at
--- h = 20 ms allows about 100 N/m per vertex, so the box rests m g / (4 k) = 9.8 mm deep.
--- Try --set rates.physics=500 with a stiffer floor for a firmer one.
+-- h = 20 ms allows about 100 N/m per vertex for this box, so it rests m g / (4 k) = 9.8 mm
+-- deep. The bound is on k / m, so the floor scales with the mass: --set mass=2 sinks the box
+-- no deeper (and then the 4 N grip is too weak to lift it: 2 mu N < m g, and it slips).
 
 local mass = param("mass", 0.4)            -- kg
 local mu = param("mu", 0.8)                -- box and floor friction
 local squeeze = param("squeeze", 0.01)     -- m: how far each finger presses into the box
 local half = 0.04                          -- m: half the box's edge
-local floor_k, floor_c = 100, 1            -- N/m, N s/m per vertex
+local floor_k = 250 * mass                 -- N/m per vertex (100 for 0.4 kg)
+local floor_c = 2.5 * mass                 -- N s/m per vertex (1 for 0.4 kg)
 local rest = half - mass * 9.81 / (4 * floor_k)   -- m: box centre height at rest
 local lift = 0.08                          -- m
 

@@ -170,7 +170,8 @@ RunResult run_scenario(const scripting::Scenario& scenario, const RunOptions& op
           result.interrupted = true;
           throw std::runtime_error("interrupted at t = " + std::to_string(sim.time()) + " s");
         }
-        if (options.progress && seconds_since(last_progress) > 0.25) {
+        // The first progress line after 2 s: a quick run prints none.
+        if (options.progress && seconds_since(start) > 2.0 && seconds_since(last_progress) > 0.25) {
           last_progress = Clock::now();
           options.progress(sim.time(), scenario.duration());
         }

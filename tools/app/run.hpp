@@ -17,7 +17,8 @@ struct RunOptions {
   std::string out;                  // trace path; "" means "<scenario name>.h5" in the working directory
   std::size_t block_rows = 1024;    // trace rows buffered per loop before a write
   int compression = 0;              // 0 none, 1..9 deflate level
-  // Called about every 0.25 s of wall time with the simulated time reached (s); may be empty.
+  // Called every 0.25 s of wall time, once a run has taken 2 s, with the simulated time reached
+  // (s); may be empty.
   std::function<void(double simulated, double duration)> progress;
   const std::atomic<bool>* interrupt = nullptr;   // set (by a signal handler) to stop the run
 };
