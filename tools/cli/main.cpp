@@ -163,7 +163,7 @@ int run_command(const std::vector<std::string>& args) {
     std::printf("  simulated   %.3f s: %lld servo, %lld haptic, %lld physics ticks\n", result.simulated,
                 static_cast<long long>(result.servo_ticks), static_cast<long long>(result.haptic_ticks),
                 static_cast<long long>(result.physics_ticks));
-    std::printf("  wall time   %.3f s (%.1fx real time)\n", result.wall,
+    std::printf("  wall time   %.3g s (%.0fx real time)\n", result.wall,
                 result.wall > 0 ? result.simulated / result.wall : 0.0);
     std::printf("  trace       %s (%s)\n", result.trace_path.c_str(), ec ? "?" : human_bytes(size).c_str());
   }
