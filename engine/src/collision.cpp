@@ -4,8 +4,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 
-#include <fcl/narrowphase/collision.h>
+#include <fcl/broadphase/broadphase_dynamic_AABB_tree.h>
 #include <fcl/narrowphase/collision_object.h>
 #include <fcl/geometry/shape/box.h>
 #include <fcl/geometry/shape/capsule.h>
@@ -29,11 +30,11 @@ bool within_face(const Vec3& h, int face, const Vec3& x) {
 }
 
 std::optional<BoxEntry> box_entry(const Vec3& h, const Vec3& a, const Vec3& b) {
-  for (int j = 0; j < 3; ++j) {
-    if (std::abs(b[j]) > h[j]) return std::nullopt;   // b is outside: no contact now
-  }
-  const bool a_inside = std::abs(a.x()) <= h.x() && std::abs(a.y()) <= h.y() && std::abs(a.z()) <= h.z();
-  if (a_inside) {
+  const auto inside = [&h](const Vec3& x) {
+    return std::abs(x.x()) <= h.x() && std::abs(x.y()) <= h.y() && std::abs(x.z()) <= h.z();
+  };
+  if (inside(a)) {
+    if (!inside(b)) return std::nullopt;   // started inside and left: nothing was entered
     // No path from outside to follow: take the face nearest to b (least depth; ties go to the
     // lower face index, so the choice is deterministic).
     int best = 0;
@@ -47,19 +48,30 @@ std::optional<BoxEntry> box_entry(const Vec3& h, const Vec3& a, const Vec3& b) {
     p[best / 2] = box_face(h, best).normal[best / 2] * h[best / 2];
     return BoxEntry{best, p, 0.0};
   }
-  // Slab method: the path enters the box when it has crossed into every slab; the last slab it
-  // enters decides the face. Axes along which the path does not move cannot be entered.
+  // Slab clipping of the path a + t (b - a), t in [0, 1]: it is inside the box while inside all
+  // three slabs; it enters at the largest slab entry, through that slab's face, if that comes
+  // before the smallest slab exit. b itself may lie beyond the box (a fast finger, a thin body):
+  // the face is still the one entered, so the finger cannot tunnel through.
   const Vec3 d = b - a;
-  double t_enter = -kInfinity;
+  double t_enter = -kInfinity, t_exit = kInfinity;
   int face = -1;
   for (int j = 0; j < 3; ++j) {
-    if (d[j] == 0.0) continue;
+    if (d[j] == 0.0) {
+      if (std::abs(a[j]) > h[j]) return std::nullopt;   // parallel to and outside this slab
+      continue;
+    }
     const bool rising = d[j] > 0.0;   // moving towards +j: enters through the -j face
-    const double t = ((rising ? -h[j] : h[j]) - a[j]) / d[j];
-    if (t > t_enter) { t_enter = t; face = 2 * j + (rising ? 1 : 0); }
+    const double t_near = ((rising ? -h[j] : h[j]) - a[j]) / d[j];
+    const double t_far = ((rising ? h[j] : -h[j]) - a[j]) / d[j];
+    if (t_near > t_enter) {   // strict: a tie (entering through an edge) keeps the lower axis
+      t_enter = t_near;
+      face = 2 * j + (rising ? 1 : 0);
+    }
+    t_exit = std::min(t_exit, t_far);
   }
-  // a outside and b inside means some axis moved and its slab was entered within [0, 1].
-  t_enter = std::clamp(t_enter, 0.0, 1.0);
+  // a is outside, so some slab is entered at t > 0; the path must reach it (t <= 1) and be in
+  // all slabs at once (t_enter <= t_exit).
+  if (face < 0 || t_enter > t_exit || t_enter > 1.0) return std::nullopt;
   Vec3 p = a + t_enter * d;
   const int axis = face / 2;
   p[axis] = (face % 2 == 0 ? 1.0 : -1.0) * h[axis];   // exactly on the face plane
@@ -70,17 +82,23 @@ std::optional<BoxEntry> box_entry(const Vec3& h, const Vec3& a, const Vec3& b) {
 }
 
 struct CollisionWorld::Impl {
-  std::vector<std::unique_ptr<fcl::CollisionObjectd>> bodies;
+  std::vector<std::unique_ptr<fcl::CollisionObjectd>> bodies;   // user data: body index + 1
+  fcl::DynamicAABBTreeCollisionManagerd broadphase;
   std::shared_ptr<fcl::Capsuled> path_shape;   // the finger path, resized per query
   std::unique_ptr<fcl::CollisionObjectd> path;
 };
 
 CollisionWorld::CollisionWorld(const Model& model) : impl_(std::make_unique<Impl>()) {
-  for (const BodyParams& b : model.bodies) {
-    const Vec3 size = 2.0 * b.half_extents;
+  std::vector<fcl::CollisionObjectd*> objects;
+  for (std::size_t i = 0; i < model.bodies.size(); ++i) {
+    const Vec3 size = 2.0 * model.bodies[i].half_extents;
     auto shape = std::make_shared<fcl::Boxd>(size.x(), size.y(), size.z());
     impl_->bodies.push_back(std::make_unique<fcl::CollisionObjectd>(shape));
+    impl_->bodies.back()->setUserData(reinterpret_cast<void*>(static_cast<std::intptr_t>(i + 1)));
+    objects.push_back(impl_->bodies.back().get());
   }
+  impl_->broadphase.registerObjects(objects);
+  impl_->broadphase.setup();
   impl_->path_shape = std::make_shared<fcl::Capsuled>(1e-6, 0.0);
   impl_->path = std::make_unique<fcl::CollisionObjectd>(impl_->path_shape);
 }
@@ -97,11 +115,23 @@ void CollisionWorld::update(const State& state) {
     impl_->bodies[i]->setTransform(tf);
     impl_->bodies[i]->computeAABB();
   }
+  impl_->broadphase.update();
 }
+
+namespace {
+// Broadphase callback: every body whose box AABB overlaps the path's is a candidate.
+bool add_candidate(fcl::CollisionObjectd* a, fcl::CollisionObjectd* b, void* data) {
+  auto* out = static_cast<std::vector<int>*>(data);
+  const fcl::CollisionObjectd* body = a->getUserData() ? a : b;   // the path has none
+  out->push_back(static_cast<int>(reinterpret_cast<std::intptr_t>(body->getUserData())) - 1);
+  return false;   // keep going
+}
+}  // namespace
 
 void CollisionWorld::bodies_touching_segment(const Vec3& a, const Vec3& b, std::vector<int>& out) const {
   out.clear();
-  // The path as a capsule of 1 um radius: a conservative filter; box_entry() then decides exactly.
+  // FCL's AABB tree finds the bodies whose bounding boxes the path's touch: a conservative
+  // filter, allocation-free. box_entry() then decides exactly, so no GJK narrowphase is run.
   const Vec3 d = b - a;
   const double length = d.norm();
   impl_->path_shape->lz = length;
@@ -111,12 +141,9 @@ void CollisionWorld::bodies_touching_segment(const Vec3& a, const Vec3& b, std::
   tf.translation() = 0.5 * (a + b);
   impl_->path->setTransform(tf);
   impl_->path->computeAABB();
-  const fcl::CollisionRequestd request;   // yes/no, no contact points
-  for (std::size_t i = 0; i < impl_->bodies.size(); ++i) {
-    fcl::CollisionResultd result;
-    if (fcl::collide(impl_->path.get(), impl_->bodies[i].get(), request, result) > 0)
-      out.push_back(static_cast<int>(i));   // visited in index order: already sorted
-  }
+  impl_->broadphase.collide(impl_->path.get(), &out, add_candidate);
+  // The tree's order depends on how it was built: sort, so that results never do.
+  std::sort(out.begin(), out.end());
 }
 
 }  // namespace graspsim

@@ -132,7 +132,6 @@ Vec3 finger_force(const Model& model, const State& state, int finger, const Vec3
   const Face face = contact_face(model, fs.body, fs.face);
   go_world = fr.R * fs.god_object + fr.p;
   const Vec3 n_w = fr.R * face.normal;
-  if (n_w.dot(go_world - hip) <= 0.0) return Vec3::Zero();   // HIP above the face: no pull
   const ContactPair pair = finger_contact_pair(model, finger, fs.body);
   Vec3 force = pair.stiffness * (go_world - hip);
   const double c = model.fingers[finger].damping;
@@ -147,16 +146,16 @@ Vec3 finger_force(const Model& model, const State& state, int finger, const Vec3
       v_go = bs.velocity + bs.angular_velocity.cross(go_world - bs.position);
     }
     force += c * (v_go - v_hip);
-    // The damper may neither pull (normal) nor carry more than friction allows (tangential):
-    // the whole contact force stays inside the cone |f_t| <= mu f_n. The spring alone is
-    // already inside it at haptic ticks; the damper is not, and would act as viscous drag
-    // while the finger slides.
-    const double f_n = n_w.dot(force);
-    if (f_n <= 0.0) return Vec3::Zero();
-    const Vec3 f_t = force - f_n * n_w;
-    const double limit = pair.mu * f_n;
-    if (f_t.squaredNorm() > limit * limit) force = f_n * n_w + f_t * (limit / f_t.norm());
   }
+  // The contact force stays inside the friction cone at every servo tick: it never pulls, and
+  // its tangential part never exceeds mu times its normal part. The friction circle keeps the
+  // spring inside the cone at haptic ticks; between them the HIP moves on while the GO waits,
+  // and a damper is not bounded by the circle at all (it would act as viscous drag).
+  const double f_n = n_w.dot(force);
+  if (f_n <= 0.0) return Vec3::Zero();
+  const Vec3 f_t = force - f_n * n_w;
+  const double limit = pair.mu * f_n;
+  if (f_t.squaredNorm() > limit * limit) force = f_n * n_w + f_t * (limit / f_t.norm());
   return force;
 }
 

@@ -50,6 +50,39 @@ Vec3 box_inertia(double m, const Vec3& h) {
   return Vec3(m / 3.0 * (s.y() + s.z()), m / 3.0 * (s.x() + s.z()), m / 3.0 * (s.x() + s.y()));
 }
 
+std::vector<std::string> stability_warnings(const Model& model) {
+  // Symplectic Euler on one mode of stiffness K, damping C and inertia M, step h, is stable when
+  // h C / M < 2 and h^2 K / M < 4 - 2 h C / M. Estimates per body, for the stiffest modes:
+  //  - all fingers pressing on it at once: K = sum k_pair, C = sum c, M = m;
+  //  - resting on its face on the floor: rocking, K / I = 12 k / m and C / I = 12 c / m for any
+  //    box on four corner springs (K = 4 k (a^2 + b^2), I = m (a^2 + b^2) / 3).
+  std::vector<std::string> out;
+  const double h = 1.0 / model.rates.physics;
+  const auto check = [&](const std::string& what, double k_over_m, double c_over_m) {
+    const double stiff = h * h * k_over_m, damp = h * c_over_m;
+    if (damp < 2.0 && stiff < 4.0 - 2.0 * damp) return;
+    std::ostringstream msg;
+    msg << what << ": the explicit integration is likely unstable at physics " << model.rates.physics
+        << " Hz (h^2 K/M = " << stiff << ", h C/M = " << damp << "; stable needs h C/M < 2 and "
+        << "h^2 K/M < 4 - 2 h C/M): lower the stiffness or damping, or raise rates.physics";
+    out.push_back(msg.str());
+  };
+  for (const BodyParams& b : model.bodies) {
+    double k = 0.0, c = 0.0;
+    for (int f = 0; f < static_cast<int>(model.fingers.size()); ++f) {
+      const Material pad{kInfinity, model.fingers[f].stiffness, kInfinity};
+      k += contact_pair(pad, b.material).stiffness;
+      c += model.fingers[f].damping;
+    }
+    if (!model.fingers.empty()) check("object '" + b.name + "' held by every finger", k / b.mass, c / b.mass);
+    if (model.floor.enabled) {
+      const ContactPair pair = contact_pair(b.material, model.floor.material);
+      check("object '" + b.name + "' on the floor", 12.0 * pair.stiffness / b.mass, 12.0 * pair.damping / b.mass);
+    }
+  }
+  return out;
+}
+
 void validate(const Model& model) {
   const Rates& r = model.rates;
   if (r.servo <= 0) fail("rates.servo", "must be a positive number of Hz (got " + std::to_string(r.servo) + ")");
@@ -70,21 +103,27 @@ void validate(const Model& model) {
     const std::string f = "objects[" + std::to_string(i + 1) + "] '" + b.name + "'";
     if (b.name.empty()) fail(f, "name must not be empty");
     if (!names.insert(b.name).second) fail(f, "name '" + b.name + "' is used twice");
-    if (!(b.half_extents.minCoeff() > 0.0) || !finite(b.half_extents)) fail(f + ".size", "every side must be > 0 m and finite");
-    if (!(b.mass > 0.0) || std::isinf(b.mass)) fail(f + ".mass", "must be > 0 kg and finite (got " + str(b.mass) + ")");
+    if (!(b.half_extents.minCoeff() > 0.0) || !finite(b.half_extents)) fail(f + ": size", "every side must be > 0 m and finite");
+    if (!(b.mass > 0.0) || std::isinf(b.mass)) fail(f + ": mass", "must be > 0 kg and finite (got " + str(b.mass) + ")");
     const Vec3& j = b.inertia;
-    if (!(j.minCoeff() > 0.0) || !finite(j)) fail(f + ".inertia", "principal moments must be > 0 kg m^2");
+    if (!(j.minCoeff() > 0.0) || !finite(j)) fail(f + ": inertia", "principal moments must be > 0 kg m^2");
     // A physical body's principal moments obey the triangle inequality J_a + J_b >= J_c.
     const double slack = 1e-12 * j.sum();
     if (j.x() + j.y() < j.z() - slack || j.y() + j.z() < j.x() - slack || j.x() + j.z() < j.y() - slack)
-      fail(f + ".inertia", "principal moments break the triangle inequality (no real body has them)");
-    check_material(f + ".material", b.material);
+      fail(f + ": inertia", "principal moments break the triangle inequality (no real body has them)");
+    check_material(f + ": material", b.material);
     if (!finite(b.position) || !finite(b.velocity) || !finite(b.angular_velocity) || !b.orientation.coeffs().allFinite())
       fail(f, "initial position, orientation and velocities must be finite");
-    if (std::abs(b.orientation.norm() - 1.0) > 1e-9) fail(f + ".orientation", "must be a unit quaternion");
-    if (model.floor.enabled && std::isinf(contact_pair(b.material, model.floor.material).stiffness))
-      fail(f + ".material.stiffness", "the object and the floor are both rigid (infinite stiffness); "
-           "the penalty floor contact needs a finite stiffness on one of them");
+    if (std::abs(b.orientation.norm() - 1.0) > 1e-9) fail(f + ": orientation", "must be a unit quaternion");
+    if (model.floor.enabled) {
+      const ContactPair pair = contact_pair(b.material, model.floor.material);
+      if (std::isinf(pair.stiffness))
+        fail(f + ": material.stiffness", "the object and the floor are both rigid (infinite "
+             "stiffness); the penalty floor contact needs a finite stiffness on one of them");
+      if (std::isinf(pair.damping))
+        fail(f + ": material.damping", "the object and the floor both leave damping unset "
+             "(infinite); the penalty floor contact needs a finite damping on one of them (0 for none)");
+    }
   }
   names.clear();
   for (std::size_t i = 0; i < model.fingers.size(); ++i) {
@@ -92,8 +131,8 @@ void validate(const Model& model) {
     const std::string f = "fingers[" + std::to_string(i + 1) + "] '" + p.name + "'";
     if (p.name.empty()) fail(f, "name must not be empty");
     if (!names.insert(p.name).second) fail(f, "name '" + p.name + "' is used twice");
-    if (!(p.stiffness > 0.0) || std::isinf(p.stiffness)) fail(f + ".stiffness", "must be > 0 N/m and finite (got " + str(p.stiffness) + ")");
-    if (!(p.damping >= 0.0) || std::isinf(p.damping)) fail(f + ".damping", "must be >= 0 N s/m and finite (got " + str(p.damping) + ")");
+    if (!(p.stiffness > 0.0) || std::isinf(p.stiffness)) fail(f + ": stiffness", "must be > 0 N/m and finite (got " + str(p.stiffness) + ")");
+    if (!(p.damping >= 0.0) || std::isinf(p.damping)) fail(f + ": damping", "must be >= 0 N s/m and finite (got " + str(p.damping) + ")");
   }
 }
 

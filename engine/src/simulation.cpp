@@ -29,6 +29,7 @@ void Simulation::step(const Input& input, TickRecord& record) {
   record.tick = n;
   record.haptic_ran = n % divisors_.haptic == 0;
   record.physics_ran = n % divisors_.physics == 0;
+  record.diverged_body = -1;
 
   // 2 haptic: the friction cone algorithm per finger.
   if (record.haptic_ran) {
@@ -54,13 +55,14 @@ void Simulation::step(const Input& input, TickRecord& record) {
       bs.window_torque += (go_world - bs.position).cross(-force);
     }
   }
-  ++state_.window_ticks;
 
   // 4 physics: residual wrench at each centre of mass, then integrate.
   if (record.physics_ran) {
     const double dt = 1.0 / model_.rates.physics;
-    // Impulse-consistent: the finger wrench is the mean over the servo ticks of the window.
-    const double per_tick = 1.0 / static_cast<double>(state_.window_ticks);
+    // Impulse-consistent: the step spans servo/physics ticks, and each servo tick's force acts
+    // for one servo period, so the body gets sum(f) / servo = mean(f) * dt. (Dividing by the
+    // ticks actually accumulated would apply tick 0's force for a whole step.)
+    const double per_tick = 1.0 / static_cast<double>(divisors_.physics);
     for (std::size_t b = 0; b < model_.bodies.size(); ++b) {
       const BodyParams& bp = model_.bodies[b];
       BodyState& bs = state_.bodies[b];
@@ -82,8 +84,11 @@ void Simulation::step(const Input& input, TickRecord& record) {
       integrate_body(bp, bs, force, torque, dt);
       bs.window_force.setZero();
       bs.window_torque.setZero();
+      const bool sane = bs.position.allFinite() && bs.rotation.allFinite() &&
+                        bs.velocity.squaredNorm() <= kDivergedSpeed * kDivergedSpeed &&
+                        bs.angular_velocity.squaredNorm() <= kDivergedAngularSpeed * kDivergedAngularSpeed;
+      if (!sane && record.diverged_body < 0) record.diverged_body = static_cast<int>(b);
     }
-    state_.window_ticks = 0;
     collision_.update(state_);
   }
 

@@ -45,7 +45,8 @@ Model floor_scene(double mu, double k) {
 // moved farther, GO is put on the circle and f_t = mu f_n exactly (sliding). The expected GO
 // is computed beside the engine with the same discrete rule, so positions agree to rounding
 // (1e-12 m; the values are ~1e-2 m) and forces to 1e-12 relative (1e-9 on the cone, where
-// the radius is rebuilt from a square root).
+// the radius is rebuilt from a square root). Between haptic ticks the HIP moves on while the GO
+// waits: the force rendered at every servo tick must still satisfy f_t <= mu f_n.
 TEST_CASE("finger force stays inside the friction cone and on it while sliding",
           "[finger_contact][law]") {
   const double k = 1000.0;   // N/m
@@ -62,6 +63,9 @@ TEST_CASE("finger force stays inside the friction cone and on it while sliding",
       int sticks = 0;
       run(sim, 3000 * 3 / 2, [&](std::size_t, double t) { return drag.hip(t); },
           [&](const TickRecord& r) {
+            // At every servo tick, between haptic ticks too, the force rendered stays in the cone.
+            const Vec3& f = r.servo[0].force;
+            REQUIRE(std::hypot(f.x(), f.y()) <= mu * f.z() * (1.0 + 1e-12));
             if (!r.haptic_ran) return;
             const HapticFingerRecord& h = r.haptic[0];
             const Vec3 hip = r.servo[0].hip;
@@ -218,4 +222,70 @@ TEST_CASE("collision world reports the bodies a finger path touches", "[collisio
   CHECK(out.empty());
   world.bodies_touching_segment(Vec3(0.05, 0.0, 0.0), Vec3(0.05, 0.0, 0.0), out);   // a point
   CHECK(out == std::vector<int>{0});
+}
+
+// No tunnelling. A finger crossing a 2 mm plate at 3 m/s moves 6 mm per haptic tick (500 Hz):
+// its path enters and leaves the plate between two ticks. The contact must still be made on the
+// face entered (+z), the depth keeps growing past the plate's thickness, and the force keeps
+// pushing the finger back up (+z). The plate is 1e9 kg, so it does not move.
+TEST_CASE("a fast finger cannot tunnel through a thin plate", "[finger_contact][law]") {
+  Model m;
+  m.gravity = Vec3::Zero();
+  const Vec3 h(0.05, 0.05, 0.001);
+  m.bodies.push_back(graspsim::test::make_box("plate", 1e9, h, Vec3::Zero()));
+  m.fingers.push_back(graspsim::test::make_finger("finger", 500.0));
+  Simulation sim(m);
+  int beyond = 0;
+  run(sim, 3000 / 10, [](std::size_t, double t) { return Vec3(0.01, 0.0, 0.01 - 3.0 * t); },
+      [&](const TickRecord& r) {
+        if (!r.haptic_ran || r.servo[0].hip.z() > h.z()) return;
+        const HapticFingerRecord& f = r.haptic[0];
+        REQUIRE(f.phase != ContactPhase::kFree);
+        REQUIRE(f.body == 0);
+        REQUIRE(f.god_object.z() == Approx(h.z()).margin(1e-8));
+        REQUIRE(f.depth == Approx(h.z() - r.servo[0].hip.z()).margin(1e-8));
+        REQUIRE(r.servo[0].force.z() > 0.0);
+        if (r.servo[0].hip.z() < -h.z()) ++beyond;   // through the plate's far side
+      });
+  REQUIRE(beyond > 10);
+}
+
+// The god-object is state in the body's frame, so it rides with the body. A body drifting and
+// spinning freely (no gravity) with a finger held fixed in the body's frame, 5 mm deep in its
+// +x face: the surface point never moves in the body frame, so the GO never slips and its
+// body-frame coordinates stay fixed, while in the world it follows the body. Checked at haptic
+// ticks that are not physics ticks (the pose is then the one the haptic stage used), to 1e-12 m
+// (rounding of the frame changes on ~0.1 m values); the body must have moved > 5 cm and turned
+// > 0.5 rad, or the test proved nothing.
+TEST_CASE("the god-object rides with a moving, turning body", "[finger_contact][law]") {
+  Model m;
+  m.gravity = Vec3::Zero();
+  const Vec3 h(0.04, 0.04, 0.04);
+  BodyParams b = graspsim::test::make_box("box", 2.0, h, Vec3(0.0, 0.0, 0.1),
+                                          Material{1.0, kInfinity, kInfinity});
+  b.velocity = Vec3(0.02, 0.05, 0.0);
+  b.angular_velocity = Vec3(0.1, -0.2, 0.6);
+  m.bodies.push_back(b);
+  m.fingers.push_back(graspsim::test::make_finger("finger", 300.0));
+  Simulation sim(m);
+  const Vec3 in_body(h.x() - 0.005, 0.01, -0.005);   // the HIP, fixed in the body frame
+  Vec3 go_body = Vec3::Constant(kInfinity);
+  run(sim, 3000 * 2,
+      [&](std::size_t, double) {
+        const BodyState& s = sim.state().bodies[0];
+        return Vec3(s.position + s.rotation * in_body);
+      },
+      [&](const TickRecord& r) {
+        if (!r.haptic_ran || r.physics_ran) return;
+        const HapticFingerRecord& f = r.haptic[0];
+        REQUIRE(f.phase == ContactPhase::kStick);
+        const BodyState& s = sim.state().bodies[0];
+        const Vec3 go = s.rotation.transpose() * (f.god_object - s.position);
+        if (!go_body.allFinite()) go_body = go;
+        REQUIRE((go - go_body).norm() < 1e-12);
+        REQUIRE(go.x() == Approx(h.x()).margin(1e-12));
+      });
+  const BodyState& s = sim.state().bodies[0];
+  CHECK((s.position - b.position).norm() > 0.05);
+  CHECK(Eigen::AngleAxisd(s.rotation).angle() > 0.5);
 }

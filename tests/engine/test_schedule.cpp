@@ -38,8 +38,10 @@ TEST_CASE("each loop runs exactly duration x rate times", "[schedule]") {
 
 // The order inside a tick is haptic, then servo force, then physics. On tick 0, with the HIP
 // already inside a box, the haptic loop makes the contact, so the servo force of that same
-// tick is non-zero, and the physics step of that same tick applies exactly its reaction
-// (a window of one tick), with gravity switched off.
+// tick is non-zero, and the physics step of that same tick includes its reaction (gravity is
+// off). Impulse consistency: that force acts for one servo period, 1/3000 s, of the 1/50 s
+// step, so the residual the step applies is -f / 60 (not -f, which would give the body 60
+// times the impulse the finger delivered).
 TEST_CASE("haptic, servo force and physics run in that order within a tick", "[schedule]") {
   Model m;
   m.gravity = Vec3::Zero();
@@ -54,7 +56,7 @@ TEST_CASE("haptic, servo force and physics run in that order within a tick", "[s
   REQUIRE(r.physics_ran);
   REQUIRE(r.haptic[0].phase == ContactPhase::kStick);
   REQUIRE(r.servo[0].force.x() == Approx(100.0 * 0.01).epsilon(1e-12));
-  REQUIRE(r.physics[0].force == -r.servo[0].force);
+  REQUIRE(r.physics[0].force.isApprox(-r.servo[0].force / 60.0, 1e-15));
 }
 
 // A rate that does not divide the servo rate is refused, naming the field.

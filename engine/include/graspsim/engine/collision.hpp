@@ -33,13 +33,14 @@ struct BoxEntry {
   double t;       // 1: fraction of the path a -> b at entry (0 when a was already inside)
 };
 
-// The entry of the path a -> b into the box when b is inside it (surface included), else none.
-// The face is the one the path crossed first: the one entered, not the nearest to b, which is
-// what keeps a deep finger from pushing through to the far side. When a is already inside (the
-// body moved onto the finger, or the first tick), the face nearest to b is taken.
+// Where the path a -> b first enters the box (surface included), else none. The face is the
+// one the path crossed first: the one entered, not the nearest to b, which keeps a deep finger
+// from pushing through to the far side; b may even lie beyond the box (a fast finger, a thin
+// body) and the entered face is still found. When a is already inside (the body moved onto the
+// finger, or the first tick), the face nearest to b is taken, if b is inside too.
 std::optional<BoxEntry> box_entry(const Vec3& half_extents, const Vec3& a, const Vec3& b);
 
-// FCL collision objects of the bodies, kept at the bodies' poses.
+// FCL collision objects of the bodies, kept at the bodies' poses, in FCL's dynamic AABB tree.
 class CollisionWorld {
  public:
   explicit CollisionWorld(const Model& model);
@@ -50,8 +51,9 @@ class CollisionWorld {
   // Moves the FCL objects to the bodies' current poses.
   void update(const State& state);
 
-  // Indices of the bodies that the segment a -> b (world) touches, ascending, written into
-  // `out` (cleared first; no allocation once its capacity suffices).
+  // Indices of the bodies whose bounding boxes the segment a -> b (world) touches, ascending,
+  // written into `out` (cleared first; no allocation once its capacity suffices). A superset of
+  // the bodies the segment enters: box_entry() decides.
   void bodies_touching_segment(const Vec3& a, const Vec3& b, std::vector<int>& out) const;
 
  private:

@@ -38,8 +38,8 @@ void finger_haptic_step(const Model& model, const State& state, const CollisionW
 // Force on the finger for the newest HIP: k (GO - HIP) + c (v_GO - v_HIP), with k the pad and
 // surface in series, c the finger's damping, v_GO the velocity of the body point under the GO
 // and v_HIP = (HIP - previous HIP) * servo rate. Zero when free, and zero when it would pull the
-// finger into the face (a contact pushes, never pulls); with damping, the tangential part is
-// limited to mu times the normal part. `go_world` receives the GO (m, world).
+// finger into the face (a contact pushes, never pulls); its tangential part is limited to mu
+// times its normal part (the cone holds at every servo tick). `go_world` receives the GO (m, world).
 Vec3 finger_force(const Model& model, const State& state, int finger, const Vec3& hip,
                   Vec3& go_world);
 

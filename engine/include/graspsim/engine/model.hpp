@@ -13,6 +13,12 @@ namespace graspsim {
 
 inline constexpr double kInfinity = std::numeric_limits<double>::infinity();
 
+// A body faster than this has left any range a grasping scene reaches: the explicit integration
+// has diverged (an unstable penalty contact launches bodies at km/s in one step before their
+// state overflows). The step flags it so that the run stops instead of finishing and "passing".
+inline constexpr double kDivergedSpeed = 1e3;          // m/s
+inline constexpr double kDivergedAngularSpeed = 1e4;   // rad/s
+
 // Loop rates. Each must divide `servo`; the scheduler runs on the servo tick.
 struct Rates {
   int servo = 3000;   // Hz: device read and force render
@@ -82,6 +88,10 @@ struct Divisors {
 
 // Checks the model and throws std::invalid_argument naming the offending field.
 void validate(const Model& model);
+
+// Warnings, one sentence each, for contacts stiff or damped enough to make the explicit
+// integration unstable at the model's physics rate (estimates; see model.cpp).
+std::vector<std::string> stability_warnings(const Model& model);
 Divisors divisors(const Rates& rates);
 
 // Principal moments of a solid box of mass m and half sizes h: J_x = m/3 (h_y^2 + h_z^2), etc.

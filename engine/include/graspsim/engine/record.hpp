@@ -54,6 +54,9 @@ struct TickRecord {
   std::vector<ServoFingerRecord> servo;     // per finger, every tick
   std::vector<HapticFingerRecord> haptic;   // per finger, valid when haptic_ran
   std::vector<BodyRecord> physics;          // per body, valid when physics_ran
+  int diverged_body = -1;                   // first body whose state this tick is not finite or
+                                            // faster than kDivergedSpeed / kDivergedAngularSpeed
+                                            // (the integration diverged), else -1
 };
 
 TickRecord make_tick_record(const Model& model);

@@ -22,8 +22,9 @@ class Simulation {
   //   3 servo    force on every finger, k (GO - HIP) with the newest HIP; its reaction, acting at
   //              the GO, is added to the contacted body's physics window
   //   4 physics  (tick % (servo/physics) == 0) for every body, in body order: record the state at
-  //              this tick; residual F = mean finger force over the window + floor + m g and
-  //              T = mean finger torque + floor torque; integrate over 1/physics s; clear window
+  //              this tick; residual F = finger impulse over the window / dt + floor + m g and
+  //              T = finger angular impulse / dt + floor torque; integrate over dt = 1/physics s;
+  //              clear the window; flag a body whose state diverged (see record.hpp)
   //   5 tick += 1
   // Time is tick / servo, computed, never accumulated.
   void step(const Input& input, TickRecord& record);

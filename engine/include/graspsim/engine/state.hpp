@@ -42,13 +42,12 @@ struct BodyState {
   Vec3 angular_velocity{0.0, 0.0, 0.0};   // rad/s, world
   std::array<VertexContact, 8> floor_contacts{};   // box vertices against the floor
   // Finger wrench accumulated over the current physics window (sum over servo ticks).
-  Vec3 window_force{0.0, 0.0, 0.0};       // N (summed, divide by window_ticks)
+  Vec3 window_force{0.0, 0.0, 0.0};       // N (summed; divided by servo/physics ticks)
   Vec3 window_torque{0.0, 0.0, 0.0};      // N m about the centre of mass (summed)
 };
 
 struct State {
   std::int64_t tick = 0;              // servo ticks done; time = tick / servo rate
-  std::int64_t window_ticks = 0;      // servo ticks accumulated into the physics window
   std::vector<BodyState> bodies;      // same order as Model::bodies
   std::vector<FingerState> fingers;   // same order as Model::fingers
 };

@@ -1,0 +1,61 @@
+// Simulation::step allocates nothing after warm-up (Drake's rule for the servo tick): a heap
+// allocation can take microseconds and its timing is unbounded, which a 3 kHz device loop
+// cannot afford. Counted with a replaced global operator new (this executable only).
+#include <catch2/catch.hpp>
+
+#include <atomic>
+#include <cstdlib>
+#include <new>
+
+#include "tests/engine/harness.hpp"
+
+namespace {
+std::atomic<long> g_allocations{0};
+}
+
+void* operator new(std::size_t n) {
+  ++g_allocations;
+  if (void* p = std::malloc(n ? n : 1)) return p;
+  throw std::bad_alloc();
+}
+void operator delete(void* p) noexcept { std::free(p); }
+void operator delete(void* p, std::size_t) noexcept { std::free(p); }
+
+using namespace graspsim;
+
+// A two-finger pinch of a box on the floor, with the fingers free and moving (broadphase queries
+// at every haptic tick), then in contact (friction cone, forces, windows), through physics steps
+// (floor contact, integration, broadphase update). After the first 10 ticks, no allocation.
+TEST_CASE("a simulation step allocates no heap memory after warm-up", "[schedule][realtime]") {
+  Model m;
+  m.floor.enabled = true;
+  m.floor.material = Material{0.8, 100.0, 1.0};
+  m.bodies.push_back(graspsim::test::make_box("box", 0.4, Vec3(0.04, 0.04, 0.04), Vec3(0.0, 0.0, 0.03),
+                                              Material{0.8, kInfinity, kInfinity}));
+  m.bodies.push_back(graspsim::test::make_box("other", 0.4, Vec3(0.04, 0.04, 0.04), Vec3(0.5, 0.0, 0.03),
+                                              Material{0.8, kInfinity, kInfinity}));
+  m.fingers.push_back(graspsim::test::make_finger("thumb", 400.0, 4.0));
+  m.fingers.push_back(graspsim::test::make_finger("index", 400.0, 4.0));
+  Simulation sim(m);
+  const auto hips = [](std::size_t i, double t) {
+    const double side = i == 0 ? -1.0 : 1.0;
+    const double x = side * std::max(0.03, 0.1 - 0.1 * t);   // contact from about t = 0.6 s
+    return Vec3(x, 0.0, 0.03 + 0.02 * std::max(0.0, t - 1.0));
+  };
+  Input input = make_input(m);
+  TickRecord record = make_tick_record(m);
+  const auto step = [&] {
+    for (std::size_t i = 0; i < 2; ++i) input.fingers[i].hip = hips(i, sim.time());
+    sim.step(input, record);
+  };
+  for (int n = 0; n < 10; ++n) step();
+  const long before = g_allocations.load();
+  int contacts = 0;
+  for (int n = 0; n < 3000 * 2; ++n) {
+    step();
+    if (record.haptic_ran && record.haptic[0].phase != ContactPhase::kFree) ++contacts;
+  }
+  const long during = g_allocations.load() - before;
+  CHECK(during == 0);
+  CHECK(contacts > 100);   // both regimes were visited
+}
