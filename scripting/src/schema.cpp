@@ -271,7 +271,12 @@ BodyParams object(const LuaValue& value, std::size_t index) {
   } else {
     fail(where, "give its mass (kg) or its density (kg/m^3)");
   }
-  body.inertia = r.vec3_or("inertia", box_inertia(body.mass, body.half_extents));
+  const Vec3 solid = box_inertia(body.mass, body.half_extents);
+  if (r.get("inertia") == nullptr && !solid.allFinite() && std::isfinite(body.mass) &&
+      body.half_extents.allFinite()) {
+    fail(r.at("size"), "too large: the box's moments of inertia overflow");
+  }
+  body.inertia = r.vec3_or("inertia", solid);
   if (const LuaValue* m = r.get("material")) body.material = material(*m, r.at("material"), Material{});
   body.position = r.vec3_or("position", body.position);
   if (const LuaValue* q = r.get("orientation")) body.orientation = quaternion(*q, r.at("orientation"));
@@ -518,12 +523,21 @@ ScenarioParts convert_scenario(const LuaValue& root, const std::string& default_
   } catch (const std::invalid_argument& e) {
     throw ConversionError(e.what());
   }
-  // A run is a whole number of servo ticks; time is tick / servo, never accumulated.
-  const double ticks = s.duration * s.model.rates.servo;
-  if (!(std::abs(ticks - std::round(ticks)) <= 1e-9 * ticks)) {
-    fail(r.at("duration"), format_short(s.duration) + " s is not a whole number of servo ticks "
-                           "at rates.servo = " + std::to_string(s.model.rates.servo) + " Hz (" +
-                           format_short(ticks) + " ticks)");
+  // Every loop runs exactly duration x rate times, so the duration is a whole number of periods
+  // of each loop; time is tick / servo, never accumulated, and exact while ticks < 2^53.
+  const Rates& rates = s.model.rates;
+  const std::pair<const char*, int> loops[] = {
+      {"servo", rates.servo}, {"haptic", rates.haptic}, {"physics", rates.physics}};
+  for (const auto& [loop, rate] : loops) {
+    const double count = s.duration * rate;
+    if (!(std::abs(count - std::round(count)) <= 1e-9 * count)) {
+      fail(r.at("duration"), format_short(s.duration) + " s is not a whole number of " + loop +
+                             " periods at rates." + loop + " = " + std::to_string(rate) + " Hz (" +
+                             format_short(count) + " ticks)");
+    }
+  }
+  if (!(s.duration * rates.servo <= 9007199254740992.0)) {
+    fail(r.at("duration"), format_short(s.duration) + " s is too long: more than 2^53 servo ticks");
   }
   return s;
 }

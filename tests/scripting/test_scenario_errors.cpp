@@ -115,14 +115,14 @@ TEST_CASE("a value of the wrong type is named with its place and both types", "[
 TEST_CASE("bad values are named with their field (the engine's validate() and the loader's own "
           "checks)", "[scenario][errors]") {
   const Broken mass = broken("negative_mass", "mass = 0.4", "mass = -0.4");
-  CHECK_THAT(mass.message, StartsWith(mass.path + ": objects[1] 'box'.mass: must be > 0 kg"));
+  CHECK_THAT(mass.message, StartsWith(mass.path + ": objects[1] 'box': mass: must be > 0 kg"));
   const Broken mu = broken("negative_mu", "mu = 0.8", "mu = -0.1");
-  CHECK_THAT(mu.message, StartsWith(mu.path + ": objects[1] 'box'.material.mu: must be >= 0"));
+  CHECK_THAT(mu.message, StartsWith(mu.path + ": objects[1] 'box': material.mu: must be >= 0"));
   const Broken rate = broken("rate_not_dividing", "physics = 100", "physics = 70");
   CHECK(rate.message == rate.path + ": rates.physics: 70 Hz does not divide rates.servo = 3000 Hz");
   const Broken duration = broken("duration_not_whole", "duration = 2.5,", "duration = 2.5001,");
   CHECK_THAT(duration.message, StartsWith(duration.path + ": duration: 2.5001 s is not a whole "
-                                          "number of servo ticks at rates.servo = 3000 Hz"));
+                                          "number of servo periods at rates.servo = 3000 Hz"));
   const Broken both = broken("mass_and_density", "mass = 0.4", "mass = 0.4, density = 500");
   CHECK(both.message == both.path + ": objects[1] 'box': give either mass or density, not both");
   const Broken neither = broken("no_mass", "mass = 0.4,", "");
@@ -152,7 +152,7 @@ TEST_CASE("bad values are named with their field (the engine's validate() and th
   const Broken check = broken("no_check", "check = function(sim)", "chek = function(sim)");
   CHECK_THAT(check.message, EndsWith("unknown field 'chek' (did you mean 'check'?)"));
   const Broken floor = broken("floor_number",
-                              "floor = { height = -0.01, material = { mu = 0.9, stiffness = 2000 } },",
+                              "floor = { height = -0.01, material = { mu = 0.9, stiffness = 2000, damping = 12 } },",
                               "floor = 1,");
   CHECK(floor.message == floor.path + ": floor: expected a table, true or false, got number");
 }

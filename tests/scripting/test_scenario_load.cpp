@@ -40,7 +40,7 @@ TEST_CASE("a valid scenario converts to the exact Model values", "[scenario][loa
   CHECK(m.floor.height == -0.01);
   CHECK(m.floor.material.mu == 0.9);
   CHECK(m.floor.material.stiffness == 2000);
-  CHECK(m.floor.material.damping == kInfinity);   // FloorParams default, not given
+  CHECK(m.floor.material.damping == 12);
 
   REQUIRE(m.bodies.size() == 2);
   const graspsim::BodyParams& box = m.bodies[0];

@@ -6,7 +6,7 @@ return {
   seed = 7,
   rates = { servo = 3000, haptic = 1000, physics = 100 },
   gravity = {0, 0, -9.81},
-  floor = { height = -0.01, material = { mu = 0.9, stiffness = 2000 } },
+  floor = { height = -0.01, material = { mu = 0.9, stiffness = 2000, damping = 12 } },
   objects = {
     { name = "box", shape = "box", size = {0.08, 0.06, 0.04}, mass = 0.4,
       position = {0, 0, 0.02},
