@@ -63,6 +63,10 @@ TEST_CASE("bad input gives exit status 2 and names the problem", "[cli][bad_inpu
       {"run " + kData + "fails_expectation.lua --duration -1", {"--duration"}},
       {"run " + kData + "fails_expectation.lua --set", {"--set needs NAME=VALUE"}},
       {"run " + kData + "fails_expectation.lua --set objects.box.mas=1" + out, {"'mas'"}},
+      {"run " + kData + "fails_expectation.lua --out ''", {"--out needs a file name"}},
+      {"run " + kData + "fails_expectation.lua --out --quiet", {"--out needs a file name"}},
+      {"run " + kData + "floor_no_damping.lua" + out, {"floor_no_damping.lua", "material.damping"}},
+      {"run " + kData + "fails_expectation.lua --duration 0.2001" + out, {"duration", "whole number"}},
   };
   for (const Case& c : cases) {
     const Outcome o = cli(c.args);
@@ -91,4 +95,18 @@ TEST_CASE("a run that fails midway keeps its trace, marked with the error", "[cl
   const std::string status = graspsim::recordings::read_string_attribute(trace, "/", "status");
   CHECK_THAT(status, Catch::StartsWith("error:") && Catch::Contains("the hand slipped"));
   CHECK(graspsim::recordings::read_dataset(trace, "/servo/tick").shape.at(0) == 1500);
+}
+
+// An unstable run is an error, not a pass: the CLI warns about the stiffness before it starts,
+// and stops with status 2 naming the object once its state is no longer finite, keeping the
+// trace up to there with status "error: ...".
+TEST_CASE("a run whose integration diverges stops with an error instead of passing", "[cli][stability]") {
+  const std::string trace = kTmp + "/cli_unstable.h5";
+  const Outcome o = cli("run " + kData + "unstable.lua --out " + trace);
+  INFO(o.output);
+  CHECK(o.status == 2);
+  CHECK_THAT(o.output, Catch::Contains("warning") && Catch::Contains("likely unstable"));
+  CHECK_THAT(o.output, Catch::Contains("objects[1] 'box' diverged"));
+  const std::string status = graspsim::recordings::read_string_attribute(trace, "/", "status");
+  CHECK_THAT(status, Catch::StartsWith("error:") && Catch::Contains("diverged"));
 }

@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <memory>
+#include <optional>
 #include <sstream>
 
 #include "graspsim/engine/simulation.hpp"
@@ -107,7 +108,13 @@ RunResult run_scenario(const scripting::Scenario& scenario, const RunOptions& op
   const auto release_all = [&devices] {
     for (auto& d : devices) d->release();
   };
+  result.warnings = stability_warnings(model);
+  std::string warnings;
+  for (const std::string& w : result.warnings) warnings += w + "\n";
+  writer.set_attribute("warnings", warnings);
+
   const auto start = Clock::now();
+  std::optional<Simulation> sim_holder;
   try {
     std::ostringstream device_list;
     for (std::size_t f = 0; f < model.fingers.size(); ++f) {
@@ -118,7 +125,7 @@ RunResult run_scenario(const scripting::Scenario& scenario, const RunOptions& op
     }
     writer.set_attribute("devices", device_list.str());
 
-    Simulation sim(model);
+    Simulation& sim = sim_holder.emplace(model);
     recordings::TraceRecorder recorder(writer, model);
     Input input = make_input(model);
     TickRecord record = make_tick_record(model);
@@ -159,6 +166,17 @@ RunResult run_scenario(const scripting::Scenario& scenario, const RunOptions& op
       for (std::size_t f = 0; f < devices.size(); ++f) rendered[f] = devices[f]->render(record.servo[f].force);
       recorder.record(record, rendered);
       ++result.servo_ticks;
+      if (record.diverged_body >= 0) {
+        const BodyState& bs = sim.state().bodies[record.diverged_body];
+        std::ostringstream msg;
+        msg << "objects[" << record.diverged_body + 1 << "] '" << model.bodies[record.diverged_body].name
+            << "' diverged at t = " << t << " s (tick " << n << "): speed "
+            << bs.velocity.norm() << " m/s, spin " << bs.angular_velocity.norm()
+            << " rad/s (limits " << kDivergedSpeed << " m/s, " << kDivergedAngularSpeed
+            << " rad/s); the explicit integration is unstable for these stiffnesses, dampings and "
+               "masses at rates.physics = " << model.rates.physics << " Hz";
+        throw std::runtime_error(msg.str());
+      }
       if (record.haptic_ran) {
         ++result.haptic_ticks;
         for (std::size_t f = 0; f < slip.size(); ++f) slip[f] += record.haptic[f].slip;
@@ -179,10 +197,10 @@ RunResult run_scenario(const scripting::Scenario& scenario, const RunOptions& op
     }
     if (ticks == 0) initial = snapshot(sim, record, slip);
     check_due(ticks);
-    result.simulated = sim.time();
   } catch (const std::exception& e) {
     result.error = e.what();
   }
+  if (sim_holder) result.simulated = sim_holder->time();
   release_all();
   result.wall = seconds_since(start);
 

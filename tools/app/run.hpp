@@ -26,8 +26,9 @@ struct RunOptions {
 struct RunResult {
   std::string trace_path;
   std::vector<scripting::ExpectationResult> expectations;
+  std::vector<std::string> warnings;   // stability warnings about the model (see engine/model.hpp)
   std::int64_t servo_ticks = 0, haptic_ticks = 0, physics_ticks = 0;
-  double simulated = 0.0;   // s
+  double simulated = 0.0;   // s: how far the run got
   double wall = 0.0;        // s
   std::string error;        // non-empty when the run stopped early (Lua error, interrupt, ...)
   bool interrupted = false;

@@ -84,31 +84,31 @@ int run_command(const std::vector<std::string>& args) {
   bool quiet = false;
   for (std::size_t i = 0; i < args.size(); ++i) {
     const std::string& a = args[i];
-    const auto value = [&](const char* flag) -> const std::string* {
+    const auto value = [&]() -> const std::string* {
       if (i + 1 >= args.size()) return nullptr;
-      (void)flag;
       return &args[++i];
     };
     if (a == "-h" || a == "--help") {
       std::cout << kHelp;
       return kExitOk;
     } else if (a == "--out") {
-      const std::string* v = value("--out");
-      if (!v) return bad_input("--out needs a file name\n" + std::string(kUsage));
+      const std::string* v = value();
+      if (!v || v->empty() || v->front() == '-')
+        return bad_input("--out needs a file name" + (v ? " (got '" + *v + "')" : std::string()));
       out = *v;
     } else if (a == "--duration") {
-      const std::string* v = value("--duration");
+      const std::string* v = value();
       double d = 0.0;
       if (!v || !parse_number(*v, d) || !(d > 0.0))
         return bad_input("--duration needs a positive number of seconds" + (v ? " (got '" + *v + "')" : std::string()));
       load.sets.push_back("duration=" + *v);
     } else if (a == "--set") {
-      const std::string* v = value("--set");
+      const std::string* v = value();
       if (!v || v->find('=') == std::string::npos || v->front() == '=')
         return bad_input("--set needs NAME=VALUE" + (v ? " (got '" + *v + "')" : std::string()));
       load.sets.push_back(*v);
     } else if (a == "--compress") {
-      const std::string* v = value("--compress");
+      const std::string* v = value();
       double level = 0.0;
       if (!v || !parse_number(*v, level) || level < 1 || level > 9 || level != std::floor(level))
         return bad_input("--compress needs a level from 1 to 9");
@@ -144,6 +144,8 @@ int run_command(const std::vector<std::string>& args) {
     };
   }
   std::signal(SIGINT, on_sigint);
+  for (const std::string& w : graspsim::stability_warnings(scenario->model()))
+    std::cerr << "graspsim: warning: " << w << "\n";
 
   graspsim::app::RunResult result;
   try {
