@@ -5,11 +5,12 @@
 graspsim_root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 graspsim_build=${GRASPSIM_BUILD_DIR:-$graspsim_root/build}
 
-# Everything graspsim needs from Debian 12, and nothing else.
+# Everything graspsim needs from Debian 12, and nothing else. hdf5-tools gives h5dump and
+# h5ls for looking into traces; the plotting packages come with the plotting tool.
 graspsim_packages=(
   g++ make cmake pkg-config git
   libeigen3-dev libfcl-dev liblua5.4-dev libhdf5-dev catch2
-  hdf5-tools python3 python3-h5py python3-matplotlib
+  hdf5-tools
 )
 
 graspsim_install_missing() {

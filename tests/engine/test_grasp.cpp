@@ -19,11 +19,20 @@ struct PinchOutcome {
   double speed;        // m/s: box speed at the end
 };
 
-// Box of mass m and half size 4 cm, no floor, held from t = 0 by two fingers at +-x pressed in
-// by depth d (their HIPs start inside; the nearest face, +-x, is taken). Fingers never move.
+// Box of mass m and half size 4 cm, no floor, gripped from t = 0 by two fingers at +-x pressed
+// in by depth d (their HIPs start inside the box, so the nearest faces, +-x, are taken; the
+// faces a moving finger enters are tested in test_friction_cone.cpp). Fingers never move. A
+// grip formed on a box already falling would let it slip while the depth, and with it the
+// friction circle, builds up: physical, but not the static law tested here.
+//
+// Physics at 500 Hz: the law does not depend on the rate, but the explicit integration does.
+// At the paper's 50 Hz the coupling must satisfy h^2 (2k/m) < 4 - 2 h C/m, which caps k/m so
+// low that the grip depth d = m g / (2 mu k) exceeds the 4 cm half size for mu = 0.3; and
+// without near-critical damping the box would overshoot to twice its sag and slip early. The
+// two-finger lift scenario shows the grasp at the paper's rates end to end.
 PinchOutcome pinch(double mass, double mu, double k, double d) {
   Model m;
-  m.rates.physics = 500;   // the law is rate-free; 500 Hz leaves room for critical damping
+  m.rates.physics = 500;
   const Vec3 h(0.04, 0.04, 0.04);
   m.bodies.push_back(make_box("box", mass, h, Vec3::Zero(), Material{mu, kInfinity, kInfinity}));
   // Critical damping of the vertical mode: stiffness 2k, so c_total = 2 sqrt(2k m), per finger

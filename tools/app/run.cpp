@@ -1,5 +1,6 @@
 // The run loop: devices -> engine -> devices, trace every tick, check expectations on time.
 #include "app/run.hpp"
+#include "graspsim_version.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -13,9 +14,6 @@
 #include "graspsim/recordings/trace_recorder.hpp"
 #include "graspsim/recordings/trace_writer.hpp"
 
-#ifndef GRASPSIM_VERSION
-#define GRASPSIM_VERSION "unknown"
-#endif
 #ifndef GRASPSIM_BUILD_FLAGS
 #define GRASPSIM_BUILD_FLAGS "unknown"
 #endif

@@ -12,12 +12,10 @@
 #include <vector>
 
 #include "app/run.hpp"
+#include "graspsim_version.hpp"
 #include "graspsim/recordings/trace_writer.hpp"
 #include "graspsim/scripting/scenario.hpp"
 
-#ifndef GRASPSIM_VERSION
-#define GRASPSIM_VERSION "unknown"
-#endif
 
 namespace {
 
