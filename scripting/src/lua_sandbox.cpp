@@ -57,16 +57,21 @@ int print_to_stderr(lua_State* state) {
   return 0;
 }
 
+// Calls the wrapped library function (upvalue 1) with the wrapper's arguments, returning its results.
+int call_wrapped(lua_State* state) {
+  lua_pushvalue(state, lua_upvalueindex(1));
+  lua_insert(state, 1);
+  lua_call(state, lua_gettop(state) - 1, LUA_MULTRET);
+  return lua_gettop(state);
+}
+
 // math.randomseed without an argument would seed from the clock: refuse it.
 int randomseed_checked(lua_State* state) {
   if (lua_isnoneornil(state, 1)) {
     return luaL_error(state, "math.randomseed needs a seed (runs must be reproducible; the "
                              "scenario's seed is already set)");
   }
-  lua_pushvalue(state, lua_upvalueindex(1));
-  lua_insert(state, 1);
-  lua_call(state, lua_gettop(state) - 1, LUA_MULTRET);
-  return lua_gettop(state);
+  return call_wrapped(state);
 }
 
 // setmetatable refusing __gc: Lua runs finalizers with hooks off, so the instruction budget
@@ -82,10 +87,7 @@ int setmetatable_checked(lua_State* state) {
                                "budget cannot stop a finalizer)");
     }
   }
-  lua_pushvalue(state, lua_upvalueindex(1));
-  lua_insert(state, 1);
-  lua_call(state, lua_gettop(state) - 1, LUA_MULTRET);
-  return lua_gettop(state);
+  return call_wrapped(state);
 }
 
 int open_libraries(lua_State* state) {
