@@ -93,6 +93,16 @@ void validate(const Model& model) {
   if (r.servo % r.physics != 0)
     fail("rates.physics", std::to_string(r.physics) + " Hz does not divide rates.servo = " + std::to_string(r.servo) + " Hz");
   if (!finite(model.gravity)) fail("gravity", "must be finite");
+  const GraspParams& g = model.grasp;
+  if (!(g.critical_area >= 0.0) || std::isinf(g.critical_area))
+    fail("grasp.critical_area", "must be >= 0 m^2 and finite (got " + str(g.critical_area) + ")");
+  if (g.torsion != Torsion::kNone && !(g.critical_area > 0.0))
+    fail("grasp.critical_area", "must be > 0 m^2 when grasp.torsion is set");
+  if (g.torsion == Torsion::kGimbal &&
+      (g.gimbal_finger < 0 || g.gimbal_finger >= static_cast<int>(model.fingers.size())))
+    fail("grasp.gimbal_finger", "must name a finger when grasp.torsion = \"gimbal\"");
+  if (!(g.dead_band >= 0.0) || std::isinf(g.dead_band))
+    fail("grasp.dead_band", "must be >= 0 N m and finite (got " + str(g.dead_band) + ")");
   if (model.floor.enabled) {
     check_material("floor.material", model.floor.material);
     if (!std::isfinite(model.floor.height)) fail("floor.height", "must be finite");

@@ -2,6 +2,7 @@
 #include "graspsim/engine/simulation.hpp"
 
 #include "graspsim/engine/finger_contact.hpp"
+#include "graspsim/engine/grasp_rules.hpp"
 #include "graspsim/engine/integrate.hpp"
 #include "graspsim/engine/object_contact.hpp"
 
@@ -59,6 +60,15 @@ void Simulation::step(const Input& input, TickRecord& record) {
   // 4 physics: residual wrench at each centre of mass, then integrate.
   if (record.physics_ran) {
     const double dt = 1.0 / model_.rates.physics;
+    // The gimbal finger's pitch change since the last physics step (section 3.2, solution 1).
+    double pitch_change = 0.0;
+    if (const int g = model_.grasp.gimbal_finger; g >= 0) {
+      FingerState& fs = state_.fingers[g];
+      const double pitch = input.fingers[g].gimbal.y();
+      if (fs.has_pitch) pitch_change = pitch - fs.pitch_at_last_physics;
+      fs.pitch_at_last_physics = pitch;
+      fs.has_pitch = true;
+    }
     // Impulse-consistent: the step spans servo/physics ticks, and each servo tick's force acts
     // for one servo period, so the body gets sum(f) / servo = mean(f) * dt. (Dividing by the
     // ticks actually accumulated would apply tick 0's force for a whole step.)
@@ -70,18 +80,35 @@ void Simulation::step(const Input& input, TickRecord& record) {
       int floor_contacts = 0;
       if (model_.floor.enabled) floor_contacts = floor_contact(model_, static_cast<int>(b), bs, floor);
       const Vec3 force = bs.window_force * per_tick + floor.force + bp.mass * model_.gravity;
-      const Vec3 torque = bs.window_torque * per_tick + floor.torque;
+      Vec3 torque = bs.window_torque * per_tick + floor.torque;
 
       BodyRecord& rec = record.physics[b];
       rec.position = bs.position;
       rec.orientation = quat_of(bs.rotation);
       rec.velocity = bs.velocity;
       rec.angular_velocity = bs.angular_velocity;
+      rec.floor_contacts = floor_contacts;
+      rec.grasp_area = 0.0;
+      rec.torsion = 0.0;
+      rec.twist = 0.0;
+
+      // Grasp rules on the residual torque (paper, 3.2 and 5), then integrate.
+      if (model_.grasp.torsion != Torsion::kNone) {
+        const TwoPointGrasp grasp = two_point_grasp(model_, state_, static_cast<int>(b));
+        if (grasp.held) {
+          rec.grasp_area = grasp.area;
+          if (model_.grasp.torsion == Torsion::kGravityDrop) {
+            rec.torsion = gravity_drop(model_, static_cast<int>(b), grasp, dt, bs, torque);
+          } else if (grasp.first == model_.grasp.gimbal_finger || grasp.second == model_.grasp.gimbal_finger) {
+            rec.twist = gimbal_twist(model_, grasp, pitch_change, bs, torque);
+          }
+        }
+      }
+      dead_band(model_.grasp.dead_band, torque);
       rec.force = force;
       rec.torque = torque;
-      rec.floor_contacts = floor_contacts;
 
-      integrate_body(bp, bs, force, torque, dt);
+      integrate_body(bp, model_.gyroscopic, bs, force, torque, dt);
       bs.window_force.setZero();
       bs.window_torque.setZero();
       const bool sane = bs.position.allFinite() && bs.rotation.allFinite() &&

@@ -53,7 +53,7 @@ TEST_CASE("R stays orthonormal after a million updates", "[integrate][law]") {
   p.inertia = Vec3(0.1, 0.2, 0.25);
   BodyState s;
   s.angular_velocity = Vec3(0.3, -1.2, 2.0);
-  for (int i = 0; i < 1000000; ++i) integrate_body(p, s, Vec3::Zero(), Vec3::Zero(), 1e-3);
+  for (int i = 0; i < 1000000; ++i) integrate_body(p, Gyroscopic::kNeglect, s, Vec3::Zero(), Vec3::Zero(), 1e-3);
   const Mat3& R = s.rotation;
   CHECK((R.transpose() * R - Mat3::Identity()).cwiseAbs().maxCoeff() < 1e-12);
   CHECK(std::abs(R.determinant() - 1.0) < 1e-12);
@@ -73,7 +73,7 @@ TEST_CASE("angular velocity is applied in the world frame", "[integrate][law]") 
   s.rotation = Eigen::AngleAxisd(M_PI / 2.0, Vec3::UnitX()).toRotationMatrix();
   s.angular_velocity = Vec3(0.0, 0.0, 1.0);
   const double dt = 1e-3;
-  integrate_body(p, s, Vec3::Zero(), Vec3::Zero(), dt);
+  integrate_body(p, Gyroscopic::kNeglect, s, Vec3::Zero(), Vec3::Zero(), dt);
   const Vec3 x_axis = s.rotation.col(0);
   CHECK(x_axis.y() == Approx(dt).epsilon(1e-6));
   CHECK(std::abs(x_axis.z()) < 1e-15);
@@ -91,7 +91,7 @@ TEST_CASE("torque about a principal axis accelerates at T / J", "[integrate][law
   for (int axis = 0; axis < 3; ++axis) {
     BodyState t = s;
     const Vec3 torque = R0.col(axis) * 0.3;   // N m, along body axis `axis`, in world
-    integrate_body(p, t, Vec3::Zero(), torque, 0.01);
+    integrate_body(p, Gyroscopic::kNeglect, t, Vec3::Zero(), torque, 0.01);
     const Vec3 expected = R0.col(axis) * (0.3 * 0.01 / p.inertia[axis]);
     CHECK((t.angular_velocity - expected).norm() < 1e-15);
   }

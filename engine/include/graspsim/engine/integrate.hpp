@@ -14,12 +14,28 @@ void orthonormalize(Mat3& rotation);
 // One step of length dt (s) under residual force F (N, world) and torque T (N m, world, about
 // the centre of mass):
 //   a = F / m                       v = v + a dt        p = p + v dt   (the new v: symplectic)
+//   w = w + dw_gyro                 (none for kNeglect, see below)
 //   w_dot = R Jp^-1 R^T T           w = w + w_dot dt
 //   R = (I + S(w) dt) R_old, then orthonormalize(R)
-// The gyroscopic term w x J w is neglected, as the paper does for small w.
+// The gyroscopic term w x J w of the paper's w_dot = J^-1 (T - w x J w), per `gyroscopic`,
+// with w_b = R_old^T w (body frame) and dw_gyro = R_old dw_b:
+//   kNeglect   dw_b = 0, the paper's approximation for small w or similar principal moments
+//              (bit for bit the paper's update; a body spun near its middle axis never flips)
+//   kExplicit  dw_b = -dt Jp^-1 (w_b x Jp w_b): with the torque term, Euler's equation by
+//              forward Euler, w_b += dt Jp^-1 (T_b - w_b x Jp w_b); adds 1/2 dt^2 g.Jp^-1 g of
+//              energy per step (g = w_b x Jp w_b)
+//   kImplicit  one Newton step of backward Euler on Jp (w - w_b) + dt w x Jp w = 0 from w_b,
+//              dw_b = -Jf^-1 (dt w_b x Jp w_b), Jf = Jp + dt (S(w_b) Jp - S(Jp w_b)) (Catto;
+//              Bullet's computeGyroscopicImpulseImplicit_Body): never adds energy while
+//              dt |w| <= Jmin / (2 Jmax) (derivation in integrate.cpp)
+// kExplicit and kImplicit are first-order accurate for Euler's equations (kNeglect is not
+// consistent with them). Where the computed w_b x Jp w_b is exactly zero (w = 0; a spin about a
+// principal axis when R^T w rounds exactly onto it) all three give the same bits. The orientation update is not an exact turn
+// about w: the n-o-a orthonormalisation turns w_b by O(|w|^2 dt^2) per step, which can add or
+// remove energy depending on the order of the moments along x, y, z (test_gyroscopic.cpp).
 // The paper writes R = R_old (I + S dt); with w in the world frame (as its w_dot is) the
 // increment belongs on the left: (I + S(w) dt) R_old = R_old (I + S(R_old^T w) dt).
-void integrate_body(const BodyParams& params, BodyState& body, const Vec3& force,
-                    const Vec3& torque, double dt);
+void integrate_body(const BodyParams& params, Gyroscopic gyroscopic, BodyState& body,
+                    const Vec3& force, const Vec3& torque, double dt);
 
 }  // namespace graspsim

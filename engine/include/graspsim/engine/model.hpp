@@ -72,8 +72,35 @@ struct FloorParams {
   Material material{1.0, kInfinity, kInfinity};
 };
 
+// How Euler's equation treats the gyroscopic term w x (J w) (paper, section 3.1).
+enum class Gyroscopic {
+  kNeglect,    // the paper's approximation for small w: w_dot = R Jp^-1 R^T T
+  kExplicit,   // w_dot = J^-1 (T - w x J w), evaluated at the start of the step
+  kImplicit,   // one Newton step of implicit Euler on the body-frame Euler equation (no energy
+               // gain from the gyroscopic term)
+};
+
+// Rotation about the axis through the god-objects of a two-finger grasp (paper, section 3.2).
+enum class Torsion {
+  kNone,          // only the residual torque acts (the fingers' forces, gravity at the centre)
+  kGravityDrop,   // A < A_crit: gravity turns the body about the axis, scaled by (1 - A/A_crit);
+                  // A >= A_crit: no rotation about the axis
+  kGimbal,        // A > A_crit: the gimbal pitch of `gimbal_finger` turns the body about the axis
+};
+
+struct GraspParams {
+  Torsion torsion = Torsion::kNone;
+  double critical_area = 0.0;   // m^2: A_crit, friction-circle area (pi r^2 of the smaller circle
+                                //      of the two fingers) at which the grasp resists torsion
+  int gimbal_finger = -1;       // index into Model::fingers whose gimbal pitch turns the body
+  double dead_band = 0.0;       // N m: T_crit; a residual torque |T| <= T_crit is set to zero
+                                //      (paper, section 5), 0 for none
+};
+
 struct Model {
   Rates rates;
+  Gyroscopic gyroscopic = Gyroscopic::kNeglect;
+  GraspParams grasp;
   Vec3 gravity{0.0, 0.0, -9.81};   // m/s^2
   FloorParams floor;
   std::vector<BodyParams> bodies;

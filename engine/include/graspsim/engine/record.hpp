@@ -14,7 +14,8 @@ namespace graspsim {
 
 // Device input of one finger for one servo tick.
 struct FingerInput {
-  Vec3 hip{0.0, 0.0, 0.0};   // m, world: haptic interface point
+  Vec3 hip{0.0, 0.0, 0.0};      // m, world: haptic interface point
+  Vec3 gimbal{0.0, 0.0, 0.0};   // rad: stylus gimbal angles (roll, pitch, yaw)
 };
 
 struct Input {
@@ -45,6 +46,10 @@ struct BodyRecord {
   Vec3 force{0.0, 0.0, 0.0};              // N, world: residual force applied this step
   Vec3 torque{0.0, 0.0, 0.0};             // N m, world: residual torque about the centre of mass
   int floor_contacts = 0;                 // 1: vertices touching the floor
+  double grasp_area = 0.0;                // m^2: friction-circle area A of a two-finger grasp
+                                          //      (0 when not held by exactly two fingers)
+  double torsion = 0.0;                   // N m: gravity-drop torque about the grasp axis
+  double twist = 0.0;                     // rad: turned about the grasp axis by the gimbal
 };
 
 struct TickRecord {

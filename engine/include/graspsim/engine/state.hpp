@@ -26,6 +26,8 @@ struct FingerState {
   int face = 0;                             // contacted face: box 0..5 = +x,-x,+y,-y,+z,-z; floor 0
   Vec3 god_object{0.0, 0.0, 0.0};           // m: GO in the contacted body's frame (world for the
                                             //    floor), so it rides with the body
+  double pitch_at_last_physics = 0.0;       // rad: gimbal pitch at the previous physics step
+  bool has_pitch = false;                   // false until the first physics step
 };
 
 // One vertex of a body against the floor: its friction anchor (the paper's god-object idea

@@ -1,0 +1,50 @@
+// Grasp rules on a body's residual wrench: torsion about a two-finger grasp axis (paper,
+// section 3.2) and the torque dead band against oscillation (section 5).
+#pragma once
+
+#include "graspsim/engine/math.hpp"
+#include "graspsim/engine/model.hpp"
+#include "graspsim/engine/record.hpp"
+#include "graspsim/engine/state.hpp"
+
+namespace graspsim {
+
+// A body held by exactly two fingers: the axis through their god-objects.
+struct TwoPointGrasp {
+  bool held = false;                  // exactly two fingers touch the body
+  int first = -1, second = -1;        // the two fingers, in finger order
+  Vec3 go_first{0.0, 0.0, 0.0};       // m, world: god-object of `first`
+  Vec3 axis{0.0, 0.0, 0.0};           // 1, world: u, unit, from the first GO to the second
+  double area = 0.0;                  // m^2: A = pi r^2 of the smaller friction circle,
+                                      //      r = mu * depth of the HIP at this tick
+};
+
+// The two-point grasp of body b, if exactly two fingers touch it and their god-objects are
+// more than 1 um apart (else `held` is false).
+TwoPointGrasp two_point_grasp(const Model& model, const State& state, int body);
+
+// Section 3.2, solution 2 (gravity-induced drop). The body turns about the grasp axis as about a
+// hinge through the god-objects (the paper's section 6 suggests taking accelerations about a
+// point near the contacts; about the centre of mass the soft finger springs would have to supply
+// the pivot force and a swinging body tears out of the grasp):
+//   A <  A_crit: w_u += dt T_drop / J_axis with T_drop = [p x m g (1 - A/A_crit)] . u,
+//                p = centre - GO, J_axis the moment of inertia about the axis;
+//   A >= A_crit: w_u = 0, no rotation about the axis.
+// The residual torque along u is removed, and the velocity corrected so that the axis itself
+// does not move. Returns T_drop (N m; 0 above A_crit).
+double gravity_drop(const Model& model, int body, const TwoPointGrasp& grasp, double dt,
+                    BodyState& bs, Vec3& torque);
+
+// Section 3.2, solution 1 (instrumented gimbal): once A > A_crit, the body turns about the axis
+// through the god-objects by the change of the gimbal finger's pitch since the last physics
+// step (positive pitch turns it positively about u); its own rotation rate about that axis is
+// set to zero, as above. Returns the angle turned (rad).
+double gimbal_twist(const Model& model, const TwoPointGrasp& grasp, double pitch_change,
+                    BodyState& bs, Vec3& torque);
+
+// Section 5: T = 0 when |T| <= T_crit.
+inline void dead_band(double t_crit, Vec3& torque) {
+  if (t_crit > 0.0 && torque.squaredNorm() <= t_crit * t_crit) torque.setZero();
+}
+
+}  // namespace graspsim

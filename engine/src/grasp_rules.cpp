@@ -1,0 +1,94 @@
+// Torsion about a two-finger grasp axis (paper, section 3.2) and the torque dead band (5).
+#include "graspsim/engine/grasp_rules.hpp"
+
+#include <cmath>
+
+#include "graspsim/engine/collision.hpp"
+#include "graspsim/engine/finger_contact.hpp"
+
+namespace graspsim {
+namespace {
+
+// Sets the body's rotation rate about the axis through `point` along unit `u` to `w_u`, as a
+// hinge: the velocity of the points on the axis does not change, so the centre of mass moves
+// on a circle about the axis. v_point = v + w x (point - c) is kept:
+//   v' = v + (w - w') x (point - c) = v + (w.u - w_u) u x (point - c).
+void set_hinge_rate(const Vec3& point, const Vec3& u, double w_u, BodyState& bs) {
+  const double change = bs.angular_velocity.dot(u) - w_u;
+  bs.angular_velocity -= change * u;
+  bs.velocity += (change * u).cross(point - bs.position);
+}
+
+// Moment of inertia about the axis through `point` along unit `u` (parallel-axis theorem):
+// J_axis = u^T (R Jp R^T) u + m |p_perp|^2, p = c - point.
+double axis_inertia(const BodyParams& bp, const BodyState& bs, const Vec3& point, const Vec3& u) {
+  const Vec3 u_body = bs.rotation.transpose() * u;
+  const Vec3 p = bs.position - point;
+  const double p_perp2 = p.squaredNorm() - p.dot(u) * p.dot(u);
+  return u_body.dot(bp.inertia.cwiseProduct(u_body)) + bp.mass * p_perp2;
+}
+
+}  // namespace
+
+TwoPointGrasp two_point_grasp(const Model& model, const State& state, int body) {
+  TwoPointGrasp g;
+  int count = 0;
+  for (std::size_t f = 0; f < state.fingers.size(); ++f) {
+    const FingerState& fs = state.fingers[f];
+    if (fs.phase == ContactPhase::kFree || fs.body != body) continue;
+    if (++count == 1) g.first = static_cast<int>(f);
+    else if (count == 2) g.second = static_cast<int>(f);
+  }
+  if (count != 2) return g;
+  const BodyState& bs = state.bodies[body];
+  const Vec3 a = bs.rotation * state.fingers[g.first].god_object + bs.position;
+  const Vec3 b = bs.rotation * state.fingers[g.second].god_object + bs.position;
+  const double length = (b - a).norm();
+  if (length <= 1e-6) return g;
+  double smallest = kInfinity;
+  for (int f : {g.first, g.second}) {
+    const FingerState& fs = state.fingers[f];
+    const Face face = box_face(model.bodies[body].half_extents, fs.face);
+    const Vec3 hip_b = bs.rotation.transpose() * (fs.hip_at_last_servo - bs.position);
+    const double depth = std::max(0.0, face.offset - face.normal.dot(hip_b));
+    smallest = std::min(smallest, finger_contact_pair(model, f, body).mu * depth);
+  }
+  g.held = true;
+  g.go_first = a;
+  g.axis = (b - a) / length;
+  g.area = M_PI * smallest * smallest;
+  return g;
+}
+
+double gravity_drop(const Model& model, int body, const TwoPointGrasp& grasp, double dt,
+                    BodyState& bs, Vec3& torque) {
+  const Vec3& u = grasp.axis;
+  const double a_crit = model.grasp.critical_area;
+  torque -= torque.dot(u) * u;   // about u the hinge rule below replaces the residual
+  if (grasp.area >= a_crit) {
+    set_hinge_rate(grasp.go_first, u, 0.0, bs);
+    return 0.0;
+  }
+  const BodyParams& bp = model.bodies[body];
+  const Vec3 p = bs.position - grasp.go_first;   // from a contact point to the centre of mass
+  const double drop = p.cross(bp.mass * model.gravity * (1.0 - grasp.area / a_crit)).dot(u);
+  const double w_u = bs.angular_velocity.dot(u) + dt * drop / axis_inertia(bp, bs, grasp.go_first, u);
+  set_hinge_rate(grasp.go_first, u, w_u, bs);
+  return drop;
+}
+
+double gimbal_twist(const Model& model, const TwoPointGrasp& grasp, double pitch_change,
+                    BodyState& bs, Vec3& torque) {
+  if (!(grasp.area > model.grasp.critical_area)) return 0.0;
+  const Vec3& u = grasp.axis;
+  torque -= torque.dot(u) * u;
+  set_hinge_rate(grasp.go_first, u, 0.0, bs);
+  if (pitch_change == 0.0) return 0.0;
+  // Turn the body, orientation and centre, about the axis through the first god-object.
+  const Mat3 turn = Eigen::AngleAxisd(pitch_change, u).toRotationMatrix();
+  bs.rotation = turn * bs.rotation;
+  bs.position = grasp.go_first + turn * (bs.position - grasp.go_first);
+  return pitch_change;
+}
+
+}  // namespace graspsim
