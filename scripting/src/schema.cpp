@@ -378,8 +378,9 @@ bool is_named_array(TableKind kind) {
 
 const std::vector<std::string>& fields_of(TableKind kind) {
   static const std::vector<std::string> kRoot = {
-      "name", "description", "duration", "seed", "rates", "gravity",
-      "floor", "objects", "fingers", "expect"};
+      "name", "description", "duration", "seed", "rates", "gravity", "gyroscopic",
+      "grasp", "floor", "objects", "fingers", "expect"};
+  static const std::vector<std::string> kGrasp = {"torsion", "critical_area", "gimbal_finger", "dead_band"};
   static const std::vector<std::string> kRates = {"servo", "haptic", "physics"};
   static const std::vector<std::string> kFloor = {"height", "material"};
   static const std::vector<std::string> kMaterial = {"mu", "stiffness", "damping"};
@@ -396,6 +397,7 @@ const std::vector<std::string>& fields_of(TableKind kind) {
     case TableKind::kRates: return kRates;
     case TableKind::kFloor: return kFloor;
     case TableKind::kMaterial: return kMaterial;
+    case TableKind::kGrasp: return kGrasp;
     case TableKind::kObject: return kObject;
     case TableKind::kFinger: return kFinger;
     case TableKind::kWaypoint: return kWaypoint;
@@ -411,6 +413,7 @@ TableKind child_kind(TableKind parent, const LuaKey& key) {
       if (key.is_index) return TableKind::kValue;
       if (name == "rates") return TableKind::kRates;
       if (name == "floor") return TableKind::kFloor;
+      if (name == "grasp") return TableKind::kGrasp;
       if (name == "gravity") return TableKind::kVector;
       if (name == "objects") return TableKind::kObjects;
       if (name == "fingers") return TableKind::kFingers;
@@ -490,6 +493,11 @@ ScenarioParts convert_scenario(const LuaValue& root, const std::string& default_
     s.seed = static_cast<std::uint64_t>(value);
   }
   s.model.gravity = r.vec3_or("gravity", s.model.gravity);
+  if (const LuaValue* g = r.get("gyroscopic")) {
+    const std::string name = choice(*g, r.at("gyroscopic"), {"neglect", "explicit", "implicit"}, "gyroscopic");
+    s.model.gyroscopic = name == "explicit" ? Gyroscopic::kExplicit
+                       : name == "implicit" ? Gyroscopic::kImplicit : Gyroscopic::kNeglect;
+  }
   s.model.floor = read_floor(r.get("floor"));
 
   if (const LuaValue* objects = r.get("objects")) {
@@ -503,6 +511,25 @@ ScenarioParts convert_scenario(const LuaValue& root, const std::string& default_
       s.model.fingers.push_back(f.params);
       s.fingers.push_back(f.setup);
       s.trajectories.push_back(std::move(f.trajectory));
+    }
+  }
+  if (const LuaValue* grasp = r.get("grasp")) {
+    if (!grasp->is_table()) fail(r.at("grasp"), "expected a table, got " + grasp->type_name());
+    const Record g(*grasp, r.at("grasp"), TableKind::kGrasp);
+    GraspParams& out = s.model.grasp;
+    if (const LuaValue* t = g.get("torsion")) {
+      const std::string name = choice(*t, g.at("torsion"), {"none", "gravity_drop", "gimbal"}, "torsion");
+      out.torsion = name == "gravity_drop" ? Torsion::kGravityDrop
+                  : name == "gimbal" ? Torsion::kGimbal : Torsion::kNone;
+    }
+    out.critical_area = g.number_or("critical_area", out.critical_area);
+    out.dead_band = g.number_or("dead_band", out.dead_band);
+    if (const LuaValue* f = g.get("gimbal_finger")) {
+      const std::string name = string_value(*f, g.at("gimbal_finger"));
+      for (std::size_t i = 0; i < s.model.fingers.size(); ++i) {
+        if (s.model.fingers[i].name == name) out.gimbal_finger = static_cast<int>(i);
+      }
+      if (out.gimbal_finger < 0) fail(g.at("gimbal_finger"), "no finger is named '" + name + "'");
     }
   }
   if (const LuaValue* expect = r.get("expect")) {

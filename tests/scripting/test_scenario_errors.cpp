@@ -156,3 +156,23 @@ TEST_CASE("bad values are named with their field (the engine's validate() and th
                               "floor = 1,");
   CHECK(floor.message == floor.path + ": floor: expected a table, true or false, got number");
 }
+
+// Bad grasp and gyroscopic values name their field.
+TEST_CASE("bad gyroscopic and grasp values are named with their field", "[scenario][errors]") {
+  const auto message = [](std::vector<std::string> sets) {
+    graspsim::scripting::LoadOptions options;
+    options.sets = std::move(sets);
+    try {
+      graspsim::scripting::Scenario::load(scripting_test::data_path("valid.lua"), options);
+    } catch (const graspsim::scripting::ScenarioError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  CHECK_THAT(message({"gyroscopic=sometimes"}), Catch::Contains("gyroscopic"));
+  CHECK_THAT(message({"grasp.torsion=twist"}), Catch::Contains("torsion"));
+  CHECK_THAT(message({"grasp.torsion=gravity_drop"}), Catch::Contains("grasp.critical_area"));
+  CHECK_THAT(message({"grasp.torsion=gimbal", "grasp.critical_area=1e-5"}), Catch::Contains("grasp.gimbal_finger"));
+  CHECK_THAT(message({"grasp.gimbal_finger=pinky"}), Catch::Contains("pinky"));
+  CHECK_THAT(message({"grasp.dead_band=-1"}), Catch::Contains("grasp.dead_band"));
+}

@@ -136,3 +136,18 @@ TEST_CASE("parameters() lists every non-function value as sorted 'path = value' 
   CHECK(has("expect.box lifted.at = 2"));
   for (const std::string& line : p) CHECK(line.find("check") == std::string::npos);   // functions left out
 }
+
+// The gyroscopic option and the grasp rules (paper 3.1, 3.2, 5) convert to the Model's enums
+// and values; a gimbal finger is named and resolved to its index.
+TEST_CASE("gyroscopic and grasp fields convert to the model", "[scenario][load]") {
+  graspsim::scripting::LoadOptions options;
+  options.sets = {"gyroscopic=implicit", "grasp.torsion=gimbal", "grasp.critical_area=2e-5",
+                  "grasp.gimbal_finger=index", "grasp.dead_band=0.003"};
+  const auto s = graspsim::scripting::Scenario::load(scripting_test::data_path("valid.lua"), options);
+  const graspsim::Model& m = s.model();
+  CHECK(m.gyroscopic == graspsim::Gyroscopic::kImplicit);
+  CHECK(m.grasp.torsion == graspsim::Torsion::kGimbal);
+  CHECK(m.grasp.critical_area == 2e-5);
+  CHECK(m.grasp.gimbal_finger == 1);
+  CHECK(m.grasp.dead_band == 0.003);
+}
