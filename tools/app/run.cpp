@@ -153,7 +153,11 @@ RunResult run_scenario(const scripting::Scenario& scenario, const RunOptions& op
     auto last_progress = start;
     for (std::int64_t n = 0; n < ticks; ++n) {
       const double t = sim.time();
-      for (std::size_t f = 0; f < devices.size(); ++f) input.fingers[f].hip = devices[f]->read(n, t).position;
+      for (std::size_t f = 0; f < devices.size(); ++f) {
+        const hw::DeviceSample sample = devices[f]->read(n, t);
+        input.fingers[f].hip = sample.position;
+        input.fingers[f].gimbal = sample.gimbal;
+      }
       if (n == 0) {
         // Before the first step no finger record exists yet: a finger is where its device is.
         for (std::size_t f = 0; f < devices.size(); ++f) record.servo[f].hip = record.haptic[f].god_object = input.fingers[f].hip;

@@ -36,7 +36,8 @@ class TraceRecorder {
     std::size_t god_object, surface_point, depth, friction_radius, force, state, body, slip;
   };
   struct PhysicsColumns {
-    std::size_t position, quaternion, velocity, angular_velocity, force, torque, floor_contacts;
+    std::size_t position, quaternion, velocity, angular_velocity, force, torque, floor_contacts,
+        grasp_area, torsion, twist;
   };
   struct TimeColumns {
     std::size_t tick;   // offset of tick
