@@ -30,8 +30,8 @@ const Material& surface_material(const Model& model, int body) {
 }  // namespace
 
 ContactPair finger_contact_pair(const Model& model, int finger, int body) {
-  // The finger pad is a spring with no friction of its own: the surface's mu rules.
-  const Material pad{kInfinity, model.fingers[finger].stiffness, kInfinity};
+  // The finger pad is a spring with no friction of its own: the surface's friction rules.
+  const Material pad{kInfinity, model.fingers[finger].stiffness, kInfinity, kInfinity, 0.0};
   return contact_pair(pad, surface_material(model, body));
 }
 
@@ -72,6 +72,7 @@ void finger_haptic_step(const Model& model, const State& state, const CollisionW
       }
     }
     track = best_t <= 1.0;
+    if (track) fs.phase = ContactPhase::kStick;   // a new contact starts sticking
   }
 
   if (track) {
@@ -83,13 +84,28 @@ void finger_haptic_step(const Model& model, const State& state, const CollisionW
     const bool on_face = fs.body < 0 || within_face(model.bodies[fs.body].half_extents, fs.face, hip_c);
     if (depth > 0.0 && on_face) {
       const Vec3 sp = hip_c + depth * face.normal;
-      // Step 2: friction circle radius = mu * depth.
+      // Step 2: friction circle radius = mu * depth. Sticking, mu is the static coefficient;
+      // slipping, the kinetic one, and viscous friction c v widens the circle by c v / k, so that
+      // the sliding force k r is mu_k f_n + c v, with v the surface point's speed over the face.
       const ContactPair pair = finger_contact_pair(model, finger, fs.body);
-      const double radius = pair.mu * depth;
-      // Steps 3 and 4: move the GO onto the circle only when it lies outside.
+      const bool was_slipping = fs.phase == ContactPhase::kSlip;
+      double radius = pair.friction(was_slipping) * depth;
+      if (was_slipping && pair.viscous > 0.0) {
+        const double v = (sp - fs.surface_point).norm() * model.rates.haptic;   // m/s
+        radius += pair.viscous * v / pair.stiffness;
+      }
+      // Steps 3 and 4: move the GO onto the circle only when it lies outside. A slipping finger
+      // whose surface point has come within the kinetic circle (it stopped moving along the
+      // surface) sticks again, and then slips only once outside the larger static circle. "Within"
+      // has a slack of 1e-9 of the radius here: a stopped finger's GO lies on the circle, and
+      // rounding must not keep it slipping for ever.
       const Vec3 before = fs.god_object;
-      const bool slipped = friction_circle_step(sp, radius, fs.god_object);
+      const bool back_to_stick =
+          was_slipping && (sp - fs.god_object).squaredNorm() <= radius * radius * (1.0 + 2e-9);
+      const bool slipped = !back_to_stick && friction_circle_step(sp, radius, fs.god_object);
+      fs.viscous_force = slipped ? pair.stiffness * (radius - pair.friction(true) * depth) : 0.0;
       fs.phase = slipped ? ContactPhase::kSlip : ContactPhase::kStick;
+      fs.surface_point = sp;
       rec.slip = slipped ? (fs.god_object - before).norm() : 0.0;
       // Step 5, the force from HIP, GO and stiffness, is finger_force(), run at the servo rate.
       const Vec3 go_w = fr.R * fs.god_object + fr.p;
@@ -108,6 +124,7 @@ void finger_haptic_step(const Model& model, const State& state, const CollisionW
 
   if (!track) {
     fs.phase = ContactPhase::kFree;
+    fs.viscous_force = 0.0;
     fs.body = kNoBody;
     fs.god_object = hip;
     rec.god_object = hip;
@@ -154,7 +171,7 @@ Vec3 finger_force(const Model& model, const State& state, int finger, const Vec3
   const double f_n = n_w.dot(force);
   if (f_n <= 0.0) return Vec3::Zero();
   const Vec3 f_t = force - f_n * n_w;
-  const double limit = pair.mu * f_n;
+  const double limit = pair.friction(fs.phase == ContactPhase::kSlip) * f_n + fs.viscous_force;
   if (f_t.squaredNorm() > limit * limit) force = f_n * n_w + f_t * (limit / f_t.norm());
   return force;
 }

@@ -23,6 +23,11 @@ void check_material(const std::string& field, const Material& m) {
   if (!(m.mu >= 0.0) || std::isinf(m.mu)) fail(field + ".mu", "must be >= 0 and finite (got " + str(m.mu) + ")");
   if (!(m.stiffness > 0.0)) fail(field + ".stiffness", "must be > 0 N/m (got " + str(m.stiffness) + ")");
   if (!(m.damping >= 0.0)) fail(field + ".damping", "must be >= 0 N s/m (got " + str(m.damping) + ")");
+  if (m.mu_kinetic >= 0.0 && !(m.mu_kinetic <= m.mu))
+    fail(field + ".mu_kinetic", "must be <= mu = " + str(m.mu) + " (got " + str(m.mu_kinetic) + ")");
+  if (std::isnan(m.mu_kinetic) || std::isinf(m.mu_kinetic)) fail(field + ".mu_kinetic", "must be finite");
+  if (!(m.viscous >= 0.0) || std::isinf(m.viscous))
+    fail(field + ".viscous", "must be >= 0 N s/m and finite (got " + str(m.viscous) + ")");
 }
 
 bool finite(const Vec3& v) { return v.allFinite(); }
@@ -37,8 +42,9 @@ ContactPair contact_pair(const Material& a, const Material& b) {
     if (std::isinf(y)) return x;
     return x * y / (x + y);
   };
-  return ContactPair{std::min(a.mu, b.mu), series(a.stiffness, b.stiffness),
-                     series(a.damping, b.damping)};
+  return ContactPair{std::min(a.mu, b.mu), std::min(kinetic_mu(a), kinetic_mu(b)),
+                     series(a.stiffness, b.stiffness), series(a.damping, b.damping),
+                     std::max(a.viscous, b.viscous)};
 }
 
 Divisors divisors(const Rates& r) {

@@ -33,11 +33,17 @@ int floor_contact(const Model& model, int body, BodyState& bs, Wrench& out) {
     const Vec3 x_t(x.x(), x.y(), floor_z);
     if (!vc.active) {
       vc.active = true;
+      vc.slipping = false;
       vc.anchor = x_t;
     }
-    friction_circle_step(x_t, pair.mu * f_n / pair.stiffness, vc.anchor);
+    // Static coefficient while stuck, kinetic (plus viscous c |u_t|) while slipping; a slipping
+    // vertex sticks again once within the kinetic circle, as a finger does.
+    const double speed_t = std::hypot(u.x(), u.y());   // m/s
+    const double mu = pair.friction(vc.slipping);
+    const double viscous = vc.slipping ? pair.viscous * speed_t : 0.0;   // N
+    vc.slipping = friction_circle_step(x_t, (mu * f_n + viscous) / pair.stiffness, vc.anchor);
     Vec3 f_t = pair.stiffness * (vc.anchor - x_t) - pair.damping * Vec3(u.x(), u.y(), 0.0);
-    const double limit = pair.mu * f_n;
+    const double limit = mu * f_n + viscous;
     const double f_t_norm = f_t.norm();
     if (f_t_norm > limit) f_t *= limit / f_t_norm;
     const Vec3 f(f_t.x(), f_t.y(), f_n);

@@ -204,6 +204,11 @@ Material material(const LuaValue& value, const Where& where, const Material& def
   m.mu = r.number_or("mu", m.mu);
   m.stiffness = r.number_or("stiffness", m.stiffness);
   m.damping = r.number_or("damping", m.damping);
+  m.mu_kinetic = r.number_or("mu_kinetic", m.mu_kinetic);
+  if (r.get("mu_kinetic") != nullptr && !(m.mu_kinetic >= 0.0)) {
+    fail(r.at("mu_kinetic"), "must be >= 0 (got " + format_short(m.mu_kinetic) + ")");
+  }
+  m.viscous = r.number_or("viscous", m.viscous);
   return m;
 }
 
@@ -383,7 +388,7 @@ const std::vector<std::string>& fields_of(TableKind kind) {
   static const std::vector<std::string> kGrasp = {"torsion", "critical_area", "gimbal_finger", "dead_band"};
   static const std::vector<std::string> kRates = {"servo", "haptic", "physics"};
   static const std::vector<std::string> kFloor = {"height", "material"};
-  static const std::vector<std::string> kMaterial = {"mu", "stiffness", "damping"};
+  static const std::vector<std::string> kMaterial = {"mu", "mu_kinetic", "stiffness", "damping", "viscous"};
   static const std::vector<std::string> kObject = {
       "name", "shape", "size", "mass", "density", "inertia", "position", "orientation",
       "velocity", "angular_velocity", "material"};

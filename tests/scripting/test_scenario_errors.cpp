@@ -158,7 +158,7 @@ TEST_CASE("bad values are named with their field (the engine's validate() and th
 }
 
 // Bad grasp and gyroscopic values name their field.
-TEST_CASE("bad gyroscopic and grasp values are named with their field", "[scenario][errors]") {
+TEST_CASE("bad gyroscopic, grasp and friction values are named with their field", "[scenario][errors]") {
   const auto message = [](std::vector<std::string> sets) {
     graspsim::scripting::LoadOptions options;
     options.sets = std::move(sets);
@@ -175,4 +175,6 @@ TEST_CASE("bad gyroscopic and grasp values are named with their field", "[scenar
   CHECK_THAT(message({"grasp.torsion=gimbal", "grasp.critical_area=1e-5"}), Catch::Contains("grasp.gimbal_finger"));
   CHECK_THAT(message({"grasp.gimbal_finger=pinky"}), Catch::Contains("pinky"));
   CHECK_THAT(message({"grasp.dead_band=-1"}), Catch::Contains("grasp.dead_band"));
+  CHECK_THAT(message({"objects.box.material.mu_kinetic=5"}), Catch::Contains("mu_kinetic") && Catch::Contains("<= mu"));
+  CHECK_THAT(message({"objects.box.material.viscous=-1"}), Catch::Contains("viscous"));
 }

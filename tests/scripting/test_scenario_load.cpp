@@ -139,10 +139,11 @@ TEST_CASE("parameters() lists every non-function value as sorted 'path = value' 
 
 // The gyroscopic option and the grasp rules (paper 3.1, 3.2, 5) convert to the Model's enums
 // and values; a gimbal finger is named and resolved to its index.
-TEST_CASE("gyroscopic and grasp fields convert to the model", "[scenario][load]") {
+TEST_CASE("gyroscopic, grasp and kinetic friction fields convert to the model", "[scenario][load]") {
   graspsim::scripting::LoadOptions options;
   options.sets = {"gyroscopic=implicit", "grasp.torsion=gimbal", "grasp.critical_area=2e-5",
-                  "grasp.gimbal_finger=index", "grasp.dead_band=0.003"};
+                  "grasp.gimbal_finger=index", "grasp.dead_band=0.003",
+                  "objects.box.material.mu_kinetic=0.3", "objects.box.material.viscous=7"};
   const auto s = graspsim::scripting::Scenario::load(scripting_test::data_path("valid.lua"), options);
   const graspsim::Model& m = s.model();
   CHECK(m.gyroscopic == graspsim::Gyroscopic::kImplicit);
@@ -150,4 +151,7 @@ TEST_CASE("gyroscopic and grasp fields convert to the model", "[scenario][load]"
   CHECK(m.grasp.critical_area == 2e-5);
   CHECK(m.grasp.gimbal_finger == 1);
   CHECK(m.grasp.dead_band == 0.003);
+  CHECK(m.bodies[0].material.mu_kinetic == 0.3);
+  CHECK(m.bodies[0].material.viscous == 7.0);
+  CHECK(graspsim::kinetic_mu(m.bodies[1].material) == m.bodies[1].material.mu);   // unset: = mu
 }

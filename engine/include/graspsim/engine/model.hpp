@@ -28,18 +28,30 @@ struct Rates {
 
 // Surface material. A contact between two surfaces combines them (see contact_pair()).
 struct Material {
-  double mu = 0.5;                // 1: Coulomb friction coefficient (friction-circle radius / depth)
+  double mu = 0.5;                // 1: static friction coefficient (friction-circle radius / depth
+                                  //    while sticking)
   double stiffness = kInfinity;   // N/m: penalty stiffness of the surface layer (per contact point)
   double damping = kInfinity;     // N s/m: damping of the surface layer (per contact point)
+  double mu_kinetic = -1.0;       // 1: kinetic friction coefficient while slipping, <= mu;
+                                  //    < 0 means equal to mu (no static peak)
+  double viscous = 0.0;           // N s/m: viscous friction while slipping, added as c v_slip
 };
 
+// The kinetic coefficient a material slips with (mu when mu_kinetic is unset).
+inline double kinetic_mu(const Material& m) { return m.mu_kinetic < 0.0 ? m.mu : m.mu_kinetic; }
+
 // The parameters of one contact between two materials: the surface layers act as springs and
-// dampers in series (1/k = 1/k_a + 1/k_b), and friction is the lower of the two coefficients,
-// so an unset (infinite) side leaves the other one in charge.
+// dampers in series (1/k = 1/k_a + 1/k_b), friction coefficients are the lower of the two, and
+// viscous friction the higher, so an unset side (infinite stiffness, damping or mu; zero
+// viscous) leaves the other one in charge.
 struct ContactPair {
-  double mu;          // 1
-  double stiffness;   // N/m
-  double damping;     // N s/m
+  double mu;           // 1: static
+  double mu_kinetic;   // 1: while slipping
+  double stiffness;    // N/m
+  double damping;      // N s/m
+  double viscous;      // N s/m: while slipping
+  // The friction coefficient of a contact that is slipping or not.
+  double friction(bool slipping) const { return slipping ? mu_kinetic : mu; }
 };
 ContactPair contact_pair(const Material& a, const Material& b);
 

@@ -26,6 +26,10 @@ struct FingerState {
   int face = 0;                             // contacted face: box 0..5 = +x,-x,+y,-y,+z,-z; floor 0
   Vec3 god_object{0.0, 0.0, 0.0};           // m: GO in the contacted body's frame (world for the
                                             //    floor), so it rides with the body
+  double viscous_force = 0.0;               // N: viscous part of the sliding force at the last
+                                            //    haptic tick (the servo force may carry it too)
+  Vec3 surface_point{0.0, 0.0, 0.0};        // m, contact frame: SP at the previous haptic tick
+                                            //    (for the slip speed of viscous friction)
   double pitch_at_last_physics = 0.0;       // rad: gimbal pitch at the previous physics step
   bool has_pitch = false;                   // false until the first physics step
 };
@@ -34,6 +38,7 @@ struct FingerState {
 // applied to object contact) while the vertex penetrates.
 struct VertexContact {
   bool active = false;
+  bool slipping = false;          // the anchor moved at the last step: kinetic friction applies
   Vec3 anchor{0.0, 0.0, 0.0};   // m, world: where the vertex stuck to the floor
 };
 
