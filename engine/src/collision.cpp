@@ -128,13 +128,15 @@ bool add_candidate(fcl::CollisionObjectd* a, fcl::CollisionObjectd* b, void* dat
 }
 }  // namespace
 
-void CollisionWorld::bodies_touching_segment(const Vec3& a, const Vec3& b, std::vector<int>& out) const {
+void CollisionWorld::bodies_touching_segment(const Vec3& a, const Vec3& b, double radius,
+                                             std::vector<int>& out) const {
   out.clear();
   // FCL's AABB tree finds the bodies whose bounding boxes the path's touch: a conservative
   // filter, allocation-free. box_entry() then decides exactly, so no GJK narrowphase is run.
   const Vec3 d = b - a;
   const double length = d.norm();
   impl_->path_shape->lz = length;
+  impl_->path_shape->radius = radius + 1e-6;
   impl_->path_shape->computeLocalAABB();
   fcl::Transform3d tf = fcl::Transform3d::Identity();
   if (length > 0.0) tf.linear() = Quat::FromTwoVectors(Vec3::UnitZ(), d).toRotationMatrix();

@@ -17,17 +17,19 @@ Frame contact_frame(const State& state, int body) {
   return Frame{Mat3::Identity(), Vec3::Zero()};
 }
 
-// The contacted face's plane in the contact frame.
-Face contact_face(const Model& model, int body, int face) {
-  if (body >= 0) return box_face(model.bodies[body].half_extents, face);
-  return Face{Vec3::UnitZ(), model.floor.height};
-}
 
 const Material& surface_material(const Model& model, int body) {
   return body >= 0 ? model.bodies[body].material : model.floor.material;
 }
 
 }  // namespace
+
+Face pad_face(const Model& model, int finger, int body, int face) {
+  Face f = body >= 0 ? box_face(model.bodies[body].half_extents, face)
+                     : Face{Vec3::UnitZ(), model.floor.height};
+  f.offset += model.fingers[finger].radius;
+  return f;
+}
 
 ContactPair finger_contact_pair(const Model& model, int finger, int body) {
   // The finger pad is a spring with no friction of its own: the surface's friction rules.
@@ -46,19 +48,23 @@ void finger_haptic_step(const Model& model, const State& state, const CollisionW
     // ties go to the lower body index, then to the floor.
     const Vec3 a = fs.has_last_haptic ? fs.hip_at_last_haptic : hip;
     double best_t = kInfinity;
-    collision.bodies_touching_segment(a, hip, scratch);
+    // A pad of radius r touches where its centre enters the box grown by r (its rounded edges
+    // and corners taken square: contact there ends at once, as off any face's edge).
+    const double r = model.fingers[finger].radius;
+    collision.bodies_touching_segment(a, hip, r, scratch);
     for (int b : scratch) {
       const BodyState& bs = state.bodies[b];
       const Vec3 a_b = bs.rotation.transpose() * (a - bs.position);
       const Vec3 hip_b = bs.rotation.transpose() * (hip - bs.position);
-      if (const auto e = box_entry(model.bodies[b].half_extents, a_b, hip_b); e && e->t < best_t) {
+      const Vec3 grown = model.bodies[b].half_extents + Vec3::Constant(r);
+      if (const auto e = box_entry(grown, a_b, hip_b); e && e->t < best_t) {
         best_t = e->t;
         fs.body = b;
         fs.face = e->face;
         fs.god_object = e->point;
       }
     }
-    const double h = model.floor.height;
+    const double h = model.floor.height + r;
     if (model.floor.enabled && hip.z() < h) {
       // Crossing z = h: the entry point on the plane; from below already, the HIP's projection.
       const double t = a.z() >= h ? (a.z() - h) / (a.z() - hip.z()) : 0.0;
@@ -77,7 +83,7 @@ void finger_haptic_step(const Model& model, const State& state, const CollisionW
 
   if (track) {
     const Frame fr = contact_frame(state, fs.body);
-    const Face face = contact_face(model, fs.body, fs.face);
+    const Face face = pad_face(model, finger, fs.body, fs.face);
     const Vec3 hip_c = fr.R.transpose() * (hip - fr.p);   // HIP in the contact frame
     // Step 1: the surface point SP, the HIP's projection on the entered face, and the depth.
     const double depth = face.offset - face.normal.dot(hip_c);
@@ -139,16 +145,17 @@ void finger_haptic_step(const Model& model, const State& state, const CollisionW
 }
 
 Vec3 finger_force(const Model& model, const State& state, int finger, const Vec3& hip,
-                  Vec3& go_world) {
+                  Vec3& contact_point) {
   const FingerState& fs = state.fingers[finger];
   if (fs.phase == ContactPhase::kFree) {
-    go_world = hip;
+    contact_point = hip;
     return Vec3::Zero();
   }
   const Frame fr = contact_frame(state, fs.body);
-  const Face face = contact_face(model, fs.body, fs.face);
-  go_world = fr.R * fs.god_object + fr.p;
+  const Face face = pad_face(model, finger, fs.body, fs.face);
+  const Vec3 go_world = fr.R * fs.god_object + fr.p;
   const Vec3 n_w = fr.R * face.normal;
+  contact_point = go_world - model.fingers[finger].radius * n_w;   // on the surface
   const ContactPair pair = finger_contact_pair(model, finger, fs.body);
   Vec3 force = pair.stiffness * (go_world - hip);
   const double c = model.fingers[finger].damping;
@@ -160,7 +167,7 @@ Vec3 finger_force(const Model& model, const State& state, int finger, const Vec3
     Vec3 v_go = Vec3::Zero();
     if (fs.body >= 0) {
       const BodyState& bs = state.bodies[fs.body];
-      v_go = bs.velocity + bs.angular_velocity.cross(go_world - bs.position);
+      v_go = bs.velocity + bs.angular_velocity.cross(contact_point - bs.position);
     }
     force += c * (v_go - v_hip);
   }

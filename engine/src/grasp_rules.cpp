@@ -48,7 +48,7 @@ TwoPointGrasp two_point_grasp(const Model& model, const State& state, int body) 
   double smallest = kInfinity;
   for (int f : {g.first, g.second}) {
     const FingerState& fs = state.fingers[f];
-    const Face face = box_face(model.bodies[body].half_extents, fs.face);
+    const Face face = pad_face(model, f, body, fs.face);
     const Vec3 hip_b = bs.rotation.transpose() * (fs.hip_at_last_servo - bs.position);
     const double depth = std::max(0.0, face.offset - face.normal.dot(hip_b));
     smallest = std::min(smallest, finger_contact_pair(model, f, body).mu * depth);

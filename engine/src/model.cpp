@@ -149,6 +149,7 @@ void validate(const Model& model) {
     if (!names.insert(p.name).second) fail(f, "name '" + p.name + "' is used twice");
     if (!(p.stiffness > 0.0) || std::isinf(p.stiffness)) fail(f + ": stiffness", "must be > 0 N/m and finite (got " + str(p.stiffness) + ")");
     if (!(p.damping >= 0.0) || std::isinf(p.damping)) fail(f + ": damping", "must be >= 0 N s/m and finite (got " + str(p.damping) + ")");
+    if (!(p.radius >= 0.0) || std::isinf(p.radius)) fail(f + ": radius", "must be >= 0 m and finite (got " + str(p.radius) + ")");
   }
 }
 

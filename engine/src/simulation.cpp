@@ -43,8 +43,8 @@ void Simulation::step(const Input& input, TickRecord& record) {
   // 3 servo: force on each finger from the newest HIP; the reaction acts on the body at the GO.
   for (std::size_t f = 0; f < fingers; ++f) {
     const Vec3& hip = input.fingers[f].hip;
-    Vec3 go_world;
-    const Vec3 force = finger_force(model_, state_, static_cast<int>(f), hip, go_world);
+    Vec3 contact_point;
+    const Vec3 force = finger_force(model_, state_, static_cast<int>(f), hip, contact_point);
     record.servo[f].hip = hip;
     record.servo[f].force = force;
     if (record.haptic_ran) record.haptic[f].force = force;   // the haptic row shows the same force
@@ -53,7 +53,7 @@ void Simulation::step(const Input& input, TickRecord& record) {
     if (b >= 0) {
       BodyState& bs = state_.bodies[b];
       bs.window_force -= force;
-      bs.window_torque += (go_world - bs.position).cross(-force);
+      bs.window_torque += (contact_point - bs.position).cross(-force);
     }
   }
 

@@ -307,6 +307,7 @@ FingerParts finger(const LuaValue& value, std::size_t index) {
   }
   out.params.stiffness = r.number_or("stiffness", out.params.stiffness);
   out.params.damping = r.number_or("damping", out.params.damping);
+  out.params.radius = r.number_or("radius", out.params.radius);
   out.setup.limits.max_force = r.number_or("max_force", out.setup.limits.max_force);
   if (!(out.setup.limits.max_force > 0.0) || std::isinf(out.setup.limits.max_force)) {
     fail(r.at("max_force"), "must be > 0 N and finite (got " +
@@ -393,7 +394,7 @@ const std::vector<std::string>& fields_of(TableKind kind) {
       "name", "shape", "size", "mass", "density", "inertia", "position", "orientation",
       "velocity", "angular_velocity", "material"};
   static const std::vector<std::string> kFinger = {
-      "name", "stiffness", "damping", "max_force", "trajectory", "interpolation"};
+      "name", "stiffness", "damping", "radius", "max_force", "trajectory", "interpolation"};
   static const std::vector<std::string> kWaypoint = {"t", "p"};
   static const std::vector<std::string> kExpectation = {"what", "at", "check"};
   static const std::vector<std::string> kNone;

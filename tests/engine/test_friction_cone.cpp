@@ -214,13 +214,16 @@ TEST_CASE("collision world reports the bodies a finger path touches", "[collisio
   CollisionWorld world(m);
   world.update(initial_state(m));
   std::vector<int> out;
-  world.bodies_touching_segment(Vec3(-0.5, 0.0, 0.0), Vec3(1.5, 0.0, 0.0), out);
+  world.bodies_touching_segment(Vec3(-0.5, 0.0, 0.0), Vec3(1.5, 0.0, 0.0), 0.0, out);
   CHECK(out == std::vector<int>{0, 1});
-  world.bodies_touching_segment(Vec3(0.5, 0.0, 0.0), Vec3(0.95, 0.0, 0.0), out);
+  world.bodies_touching_segment(Vec3(0.5, 0.0, 0.0), Vec3(0.95, 0.0, 0.0), 0.0, out);
   CHECK(out == std::vector<int>{1});
-  world.bodies_touching_segment(Vec3(0.5, 0.5, 0.0), Vec3(0.6, 0.5, 0.0), out);
+  world.bodies_touching_segment(Vec3(0.5, 0.5, 0.0), Vec3(0.6, 0.5, 0.0), 0.0, out);
   CHECK(out.empty());
-  world.bodies_touching_segment(Vec3(0.05, 0.0, 0.0), Vec3(0.05, 0.0, 0.0), out);   // a point
+  // The same path swept by a 0.45 m pad reaches both boxes' bounding boxes.
+  world.bodies_touching_segment(Vec3(0.5, 0.5, 0.0), Vec3(0.6, 0.5, 0.0), 0.45, out);
+  CHECK(out == std::vector<int>{0, 1});
+  world.bodies_touching_segment(Vec3(0.05, 0.0, 0.0), Vec3(0.05, 0.0, 0.0), 0.0, out);   // a point
   CHECK(out == std::vector<int>{0});
 }
 

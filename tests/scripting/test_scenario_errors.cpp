@@ -92,8 +92,8 @@ TEST_CASE("an unknown field is named with its place and the closest known name",
         ": fingers[1] 'thumb': trajectory[2]: unknown field 'pos' (known fields: t, p)");
   const Broken two = broken("two_unknown_fields", "max_force = 8", "zeta = 1, alpha = 2");
   CHECK(two.message == two.path + ": fingers[1] 'thumb': unknown field 'alpha' (known fields: "
-        "name, stiffness, damping, max_force, trajectory, interpolation); unknown field 'zeta' (known "
-        "fields: name, stiffness, damping, max_force, trajectory, interpolation)");
+        "name, stiffness, damping, radius, max_force, trajectory, interpolation); unknown field 'zeta' (known "
+        "fields: name, stiffness, damping, radius, max_force, trajectory, interpolation)");
   const Broken expectation = broken("unknown_expect_field", "at = 2,", "when = 2,");
   CHECK_THAT(expectation.message, StartsWith(expectation.path + ": expect[1] 'box lifted': unknown field 'when'"));
 }
@@ -177,4 +177,5 @@ TEST_CASE("bad gyroscopic, grasp and friction values are named with their field"
   CHECK_THAT(message({"grasp.dead_band=-1"}), Catch::Contains("grasp.dead_band"));
   CHECK_THAT(message({"objects.box.material.mu_kinetic=5"}), Catch::Contains("mu_kinetic") && Catch::Contains("<= mu"));
   CHECK_THAT(message({"objects.box.material.viscous=-1"}), Catch::Contains("viscous"));
+  CHECK_THAT(message({"fingers.thumb.radius=-0.01"}), Catch::Contains("radius"));
 }

@@ -143,7 +143,8 @@ TEST_CASE("gyroscopic, grasp and kinetic friction fields convert to the model", 
   graspsim::scripting::LoadOptions options;
   options.sets = {"gyroscopic=implicit", "grasp.torsion=gimbal", "grasp.critical_area=2e-5",
                   "grasp.gimbal_finger=index", "grasp.dead_band=0.003",
-                  "objects.box.material.mu_kinetic=0.3", "objects.box.material.viscous=7"};
+                  "objects.box.material.mu_kinetic=0.3", "objects.box.material.viscous=7",
+                  "fingers.thumb.radius=0.008"};
   const auto s = graspsim::scripting::Scenario::load(scripting_test::data_path("valid.lua"), options);
   const graspsim::Model& m = s.model();
   CHECK(m.gyroscopic == graspsim::Gyroscopic::kImplicit);
@@ -153,5 +154,7 @@ TEST_CASE("gyroscopic, grasp and kinetic friction fields convert to the model", 
   CHECK(m.grasp.dead_band == 0.003);
   CHECK(m.bodies[0].material.mu_kinetic == 0.3);
   CHECK(m.bodies[0].material.viscous == 7.0);
+  CHECK(m.fingers[0].radius == 0.008);
+  CHECK(m.fingers[1].radius == 0.0);
   CHECK(graspsim::kinetic_mu(m.bodies[1].material) == m.bodies[1].material.mu);   // unset: = mu
 }

@@ -51,10 +51,10 @@ class CollisionWorld {
   // Moves the FCL objects to the bodies' current poses.
   void update(const State& state);
 
-  // Indices of the bodies whose bounding boxes the segment a -> b (world) touches, ascending,
-  // written into `out` (cleared first; no allocation once its capacity suffices). A superset of
-  // the bodies the segment enters: box_entry() decides.
-  void bodies_touching_segment(const Vec3& a, const Vec3& b, std::vector<int>& out) const;
+  // Indices of the bodies whose bounding boxes the segment a -> b (world), swept by a sphere of
+  // `radius` (m), touches, ascending, written into `out` (cleared first; no allocation once its
+  // capacity suffices). A superset of the bodies the segment enters: box_entry() decides.
+  void bodies_touching_segment(const Vec3& a, const Vec3& b, double radius, std::vector<int>& out) const;
 
  private:
   struct Impl;

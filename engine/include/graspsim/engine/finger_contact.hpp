@@ -27,6 +27,11 @@ inline bool friction_circle_step(const Vec3& sp, double radius, Vec3& go) {
 // Contact parameters of finger f on body b (or kFloor): the pad and the surface in series.
 ContactPair finger_contact_pair(const Model& model, int finger, int body);
 
+// The plane the pad centre of finger f is held to on face `face` of body b (or the floor), in
+// the contact frame: the face moved out by the pad's radius (a sphere touching a plane is a
+// point touching the plane offset by its radius).
+Face pad_face(const Model& model, int finger, int body, int face);
+
 // One haptic tick of finger f with the HIP at `hip` (m, world): finds a new contact when the
 // finger is free (the face its path entered), else runs the friction cone on the contacted face.
 // Fills every field of `rec` but `force`, which the servo stage sets (finger_force()).

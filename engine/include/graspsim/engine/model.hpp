@@ -76,6 +76,7 @@ struct FingerParams {
   double stiffness = 500.0;   // N/m: virtual coupling between HIP and god-object (finger pad)
   double damping = 0.0;       // N s/m: damping of that coupling on the GO-HIP relative velocity
                               //        (0 is the paper's pure spring)
+  double radius = 0.0;        // m: finger pad radius; the HIP is the pad's centre (0: a point)
 };
 
 struct FloorParams {

@@ -20,7 +20,8 @@ class Simulation {
   //   1 servo    the HIP of every finger from `input`
   //   2 haptic   (tick % (servo/haptic) == 0) friction cone for every finger, in finger order
   //   3 servo    force on every finger, k (GO - HIP) with the newest HIP; its reaction, acting at
-  //              the GO, is added to the contacted body's physics window
+  //              the contact point on the surface (GO less the pad radius), is added to the
+  //              contacted body's physics window
   //   4 physics  (tick % (servo/physics) == 0) for every body, in body order: record the state at
   //              this tick; residual F = finger impulse over the window / dt + floor + m g and
   //              T = finger angular impulse / dt + floor torque; integrate over dt = 1/physics s;
