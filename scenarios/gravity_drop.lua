@@ -8,7 +8,7 @@
 -- area (pi (mu d)^2 = 2.0e-4 m^2 for d = 8 mm) and A_crit the area at which the pads would hold
 -- the rod level (here 2 A, so half the gravity torque acts). The rod swings down about the
 -- axis like a pendulum with half gravity (small swings would take 2 pi sqrt(J_axis / (m g d /
--- 2)) = 0.79 s): released level, it passes the bottom after about 0.3 s and rises level on the
+-- 2)) = 1.0 s): released level, it passes the bottom after about 0.3 s and rises level on the
 -- other side, and swings on, undamped, since the paper's torque has no torsional loss. The
 -- fingers stick throughout. Try --set grasp.critical_area=1e-4 (below A: the pads hold the rod
 -- level, and the first expectation fails) or --set rates.physics=500.

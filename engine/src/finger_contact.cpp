@@ -24,6 +24,16 @@ const Material& surface_material(const Model& model, int body) {
 
 }  // namespace
 
+bool stick_slip_step(const Vec3& sp, double static_radius, double kinetic_radius,
+                     const Vec3& v_rel_t, bool was_slipping, Vec3& go) {
+  if (!was_slipping) return friction_circle_step(sp, static_radius, go);
+  const Vec3 d = sp - go;
+  const bool within = d.squaredNorm() <= kinetic_radius * kinetic_radius * (1.0 + 2e-9);
+  if (within && v_rel_t.dot(d) <= 0.0) return false;   // stopped or turned back: stick
+  friction_circle_step(sp, kinetic_radius, go);
+  return true;
+}
+
 Face pad_face(const Model& model, int finger, int body, int face) {
   Face f = body >= 0 ? box_face(model.bodies[body].half_extents, face)
                      : Face{Vec3::UnitZ(), model.floor.height};
@@ -90,32 +100,38 @@ void finger_haptic_step(const Model& model, const State& state, const CollisionW
     const bool on_face = fs.body < 0 || within_face(model.bodies[fs.body].half_extents, fs.face, hip_c);
     if (depth > 0.0 && on_face) {
       const Vec3 sp = hip_c + depth * face.normal;
-      // Step 2: friction circle radius = mu * depth. Sticking, mu is the static coefficient;
-      // slipping, the kinetic one, and viscous friction c v widens the circle by c v / k, so that
-      // the sliding force k r is mu_k f_n + c v, with v the surface point's speed over the face.
+      // Step 2: friction circle radius = mu * depth: the static coefficient while sticking;
+      // while slipping the kinetic one, widened by c v / k for viscous friction c v, so that the
+      // sliding force k r is mu_k f_n + c v, v the finger's tangential speed over the surface.
       const ContactPair pair = finger_contact_pair(model, finger, fs.body);
       const bool was_slipping = fs.phase == ContactPhase::kSlip;
-      double radius = pair.friction(was_slipping) * depth;
-      if (was_slipping && pair.viscous > 0.0) {
-        const double v = (sp - fs.surface_point).norm() * model.rates.haptic;   // m/s
-        radius += pair.viscous * v / pair.stiffness;
-      }
-      // Steps 3 and 4: move the GO onto the circle only when it lies outside. A slipping finger
-      // whose surface point has come within the kinetic circle (it stopped moving along the
-      // surface) sticks again, and then slips only once outside the larger static circle. "Within"
-      // has a slack of 1e-9 of the radius here: a stopped finger's GO lies on the circle, and
-      // rounding must not keep it slipping for ever.
-      const Vec3 before = fs.god_object;
-      const bool back_to_stick =
-          was_slipping && (sp - fs.god_object).squaredNorm() <= radius * radius * (1.0 + 2e-9);
-      const bool slipped = !back_to_stick && friction_circle_step(sp, radius, fs.god_object);
-      fs.viscous_force = slipped ? pair.stiffness * (radius - pair.friction(true) * depth) : 0.0;
-      fs.phase = slipped ? ContactPhase::kSlip : ContactPhase::kStick;
-      fs.surface_point = sp;
-      rec.slip = slipped ? (fs.god_object - before).norm() : 0.0;
-      // Step 5, the force from HIP, GO and stiffness, is finger_force(), run at the servo rate.
+      const Vec3 n_w = fr.R * face.normal;
       const Vec3 go_w = fr.R * fs.god_object + fr.p;
-      rec.god_object = go_w;
+      Vec3 v_rel = fs.has_last_haptic ? Vec3((hip - fs.hip_at_last_haptic) * static_cast<double>(model.rates.haptic))
+                                      : Vec3::Zero();
+      if (fs.body >= 0) {
+        const BodyState& bs = state.bodies[fs.body];
+        v_rel -= bs.velocity + bs.angular_velocity.cross(go_w - bs.position);
+      }
+      const Vec3 v_rel_t = v_rel - v_rel.dot(n_w) * n_w;   // m/s, world
+      const double viscous = pair.viscous * v_rel_t.norm();  // N, while slipping
+      const double kinetic_radius = pair.friction(true) * depth + viscous / pair.stiffness;
+      // Steps 3 and 4: move the GO onto the circle only when it lies outside (stick_slip_step
+      // says when a slipping finger sticks again).
+      const Vec3 before = fs.god_object;
+      const bool slipped = stick_slip_step(sp, pair.mu * depth, kinetic_radius,
+                                           fr.R.transpose() * v_rel_t, was_slipping, fs.god_object);
+      // The tick the finger breaks away, its GO goes onto the static circle (the force peaks at
+      // mu_s f_n); from the next tick on it slides on the kinetic one.
+      const bool sliding = slipped && was_slipping;
+      const double radius = sliding ? kinetic_radius : pair.mu * depth;
+      fs.friction_mu = sliding ? pair.friction(true) : pair.mu;
+      fs.viscous_force = sliding ? viscous : 0.0;
+      fs.friction_radius = radius;
+      fs.phase = slipped ? ContactPhase::kSlip : ContactPhase::kStick;
+      rec.slip = (fs.god_object - before).norm();
+      // Step 5, the force from HIP, GO and stiffness, is finger_force(), run at the servo rate.
+      rec.god_object = fr.R * fs.god_object + fr.p;
       rec.surface_point = fr.R * sp + fr.p;
       rec.depth = depth;
       rec.friction_radius = radius;
@@ -131,6 +147,7 @@ void finger_haptic_step(const Model& model, const State& state, const CollisionW
   if (!track) {
     fs.phase = ContactPhase::kFree;
     fs.viscous_force = 0.0;
+    fs.friction_radius = 0.0;
     fs.body = kNoBody;
     fs.god_object = hip;
     rec.god_object = hip;
@@ -178,7 +195,7 @@ Vec3 finger_force(const Model& model, const State& state, int finger, const Vec3
   const double f_n = n_w.dot(force);
   if (f_n <= 0.0) return Vec3::Zero();
   const Vec3 f_t = force - f_n * n_w;
-  const double limit = pair.friction(fs.phase == ContactPhase::kSlip) * f_n + fs.viscous_force;
+  const double limit = fs.friction_mu * f_n + fs.viscous_force;   // as at the last haptic tick
   if (f_t.squaredNorm() > limit * limit) force = f_n * n_w + f_t * (limit / f_t.norm());
   return force;
 }

@@ -40,49 +40,68 @@ TwoPointGrasp two_point_grasp(const Model& model, const State& state, int body) 
     else if (count == 2) g.second = static_cast<int>(f);
   }
   if (count != 2) return g;
+  const FingerState& first = state.fingers[g.first];
+  const FingerState& second = state.fingers[g.second];
+  // A grasp squeezes from opposite sides: two fingers pressing one face (or adjacent ones)
+  // hold nothing between them.
+  const Vec3& h = model.bodies[body].half_extents;
+  if (box_face(h, first.face).normal.dot(box_face(h, second.face).normal) >= 0.0) return g;
   const BodyState& bs = state.bodies[body];
-  const Vec3 a = bs.rotation * state.fingers[g.first].god_object + bs.position;
-  const Vec3 b = bs.rotation * state.fingers[g.second].god_object + bs.position;
+  const Vec3 a = bs.rotation * first.god_object + bs.position;
+  const Vec3 b = bs.rotation * second.god_object + bs.position;
   const double length = (b - a).norm();
   if (length <= 1e-6) return g;
-  double smallest = kInfinity;
-  for (int f : {g.first, g.second}) {
-    const FingerState& fs = state.fingers[f];
-    const Face face = pad_face(model, f, body, fs.face);
-    const Vec3 hip_b = bs.rotation.transpose() * (fs.hip_at_last_servo - bs.position);
-    const double depth = std::max(0.0, face.offset - face.normal.dot(hip_b));
-    smallest = std::min(smallest, finger_contact_pair(model, f, body).mu * depth);
-  }
+  const double r = std::min(first.friction_radius, second.friction_radius);
   g.held = true;
   g.go_first = a;
   g.axis = (b - a) / length;
-  g.area = M_PI * smallest * smallest;
+  g.area = M_PI * r * r;
   return g;
 }
 
-double gravity_drop(const Model& model, int body, const TwoPointGrasp& grasp, double dt,
-                    BodyState& bs, Vec3& torque) {
-  const Vec3& u = grasp.axis;
-  const double a_crit = model.grasp.critical_area;
-  torque -= torque.dot(u) * u;   // about u the hinge rule below replaces the residual
-  if (grasp.area >= a_crit) {
-    set_hinge_rate(grasp.go_first, u, 0.0, bs);
-    return 0.0;
-  }
-  const BodyParams& bp = model.bodies[body];
-  const Vec3 p = bs.position - grasp.go_first;   // from a contact point to the centre of mass
-  const double drop = p.cross(bp.mass * model.gravity * (1.0 - grasp.area / a_crit)).dot(u);
-  const double w_u = bs.angular_velocity.dot(u) + dt * drop / axis_inertia(bp, bs, grasp.go_first, u);
-  set_hinge_rate(grasp.go_first, u, w_u, bs);
-  return drop;
+namespace {
+
+// Removes from `torque` the angular acceleration it would give about u, so that the rate set
+// about the axis survives the integration when u is not a principal axis: with
+// alpha = I^-1 T (I = R Jp R^T), T' = T - (alpha . u) I u gives alpha' = alpha - (alpha . u) u.
+void keep_axis_rate(const BodyParams& bp, const BodyState& bs, const Vec3& u, Vec3& torque) {
+  const Mat3& R = bs.rotation;
+  const Vec3 alpha = R * (R.transpose() * torque).cwiseQuotient(bp.inertia);
+  const Vec3 i_u = R * bp.inertia.cwiseProduct(R.transpose() * u);
+  torque -= alpha.dot(u) * i_u;
 }
 
-double gimbal_twist(const Model& model, const TwoPointGrasp& grasp, double pitch_change,
+}  // namespace
+
+double gravity_drop(const Model& model, int body, const TwoPointGrasp& grasp, double dt,
+                    const Vec3& floor_force, const Vec3& floor_torque, BodyState& bs, Vec3& torque) {
+  const Vec3& u = grasp.axis;
+  const BodyParams& bp = model.bodies[body];
+  torque -= torque.dot(u) * u;   // about u the hinge rule below replaces the residual
+  double turning = 0.0;
+  if (grasp.area < model.grasp.critical_area) {
+    // About the axis: the paper's scaled gravity torque, plus what else pushes the body (the
+    // floor's torque about the axis point: T_c + (c - GO) x F); the fingers hold the axis.
+    const Vec3 p = bs.position - grasp.go_first;   // from a contact point to the centre of mass
+    const double drop = p.cross(bp.mass * model.gravity * (1.0 - grasp.area / model.grasp.critical_area)).dot(u);
+    turning = drop + (floor_torque + p.cross(floor_force)).dot(u);
+    if (std::abs(turning) <= model.grasp.dead_band) turning = 0.0;   // section 5, about u too
+  }
+  const double w_u = grasp.area < model.grasp.critical_area
+      ? bs.angular_velocity.dot(u) + dt * turning / axis_inertia(bp, bs, grasp.go_first, u)
+      : 0.0;
+  set_hinge_rate(grasp.go_first, u, w_u, bs);
+  keep_axis_rate(bp, bs, u, torque);
+  return turning;
+}
+
+double gimbal_twist(const Model& model, int body, const TwoPointGrasp& grasp, double pitch_change,
                     BodyState& bs, Vec3& torque) {
   if (!(grasp.area > model.grasp.critical_area)) return 0.0;
   const Vec3& u = grasp.axis;
   torque -= torque.dot(u) * u;
   set_hinge_rate(grasp.go_first, u, 0.0, bs);
+  keep_axis_rate(model.bodies[body], bs, u, torque);
   if (pitch_change == 0.0) return 0.0;
   // Turn the body, orientation and centre, about the axis through the first god-object.
   const Mat3 turn = Eigen::AngleAxisd(pitch_change, u).toRotationMatrix();

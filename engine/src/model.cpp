@@ -104,9 +104,11 @@ void validate(const Model& model) {
     fail("grasp.critical_area", "must be >= 0 m^2 and finite (got " + str(g.critical_area) + ")");
   if (g.torsion != Torsion::kNone && !(g.critical_area > 0.0))
     fail("grasp.critical_area", "must be > 0 m^2 when grasp.torsion is set");
-  if (g.torsion == Torsion::kGimbal &&
-      (g.gimbal_finger < 0 || g.gimbal_finger >= static_cast<int>(model.fingers.size())))
-    fail("grasp.gimbal_finger", "must name a finger when grasp.torsion = \"gimbal\"");
+  if (g.gimbal_finger >= static_cast<int>(model.fingers.size()) || g.gimbal_finger < -1)
+    fail("grasp.gimbal_finger", "is not a finger");
+  if ((g.torsion == Torsion::kGimbal) != (g.gimbal_finger >= 0))
+    fail("grasp.gimbal_finger", "names the finger whose gimbal turns the body, with grasp.torsion = "
+         "\"gimbal\" and only then");
   if (!(g.dead_band >= 0.0) || std::isinf(g.dead_band))
     fail("grasp.dead_band", "must be >= 0 N m and finite (got " + str(g.dead_band) + ")");
   if (model.floor.enabled) {

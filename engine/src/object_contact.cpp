@@ -36,14 +36,17 @@ int floor_contact(const Model& model, int body, BodyState& bs, Wrench& out) {
       vc.slipping = false;
       vc.anchor = x_t;
     }
-    // Static coefficient while stuck, kinetic (plus viscous c |u_t|) while slipping; a slipping
-    // vertex sticks again once within the kinetic circle, as a finger does.
-    const double speed_t = std::hypot(u.x(), u.y());   // m/s
+    // Static coefficient while stuck, kinetic (plus viscous c |u_t|) while slipping, with the
+    // fingers' rule for sticking again (stick_slip_step), on the vertex's velocity over the floor.
+    const Vec3 u_t(u.x(), u.y(), 0.0);   // m/s
+    const double viscous = pair.viscous * u_t.norm();   // N, while slipping
+    vc.slipping = stick_slip_step(x_t, pair.mu * f_n / pair.stiffness,
+                                  (pair.friction(true) * f_n + viscous) / pair.stiffness, u_t,
+                                  vc.slipping, vc.anchor);
     const double mu = pair.friction(vc.slipping);
-    const double viscous = vc.slipping ? pair.viscous * speed_t : 0.0;   // N
-    vc.slipping = friction_circle_step(x_t, (mu * f_n + viscous) / pair.stiffness, vc.anchor);
+    const double limit_viscous = vc.slipping ? viscous : 0.0;
     Vec3 f_t = pair.stiffness * (vc.anchor - x_t) - pair.damping * Vec3(u.x(), u.y(), 0.0);
-    const double limit = mu * f_n + viscous;
+    const double limit = mu * f_n + limit_viscous;
     const double f_t_norm = f_t.norm();
     if (f_t_norm > limit) f_t *= limit / f_t_norm;
     const Vec3 f(f_t.x(), f_t.y(), f_n);

@@ -98,9 +98,11 @@ void Simulation::step(const Input& input, TickRecord& record) {
         if (grasp.held) {
           rec.grasp_area = grasp.area;
           if (model_.grasp.torsion == Torsion::kGravityDrop) {
-            rec.torsion = gravity_drop(model_, static_cast<int>(b), grasp, dt, bs, torque);
+            rec.torsion = gravity_drop(model_, static_cast<int>(b), grasp, dt, floor.force, floor.torque, bs, torque);
           } else if (grasp.first == model_.grasp.gimbal_finger || grasp.second == model_.grasp.gimbal_finger) {
-            rec.twist = gimbal_twist(model_, grasp, pitch_change, bs, torque);
+            TwoPointGrasp toward_other = grasp;   // u from the gimbal finger to the other one
+            if (grasp.second == model_.grasp.gimbal_finger) toward_other.axis = -grasp.axis;
+            rec.twist = gimbal_twist(model_, static_cast<int>(b), toward_other, pitch_change, bs, torque);
           }
         }
       }

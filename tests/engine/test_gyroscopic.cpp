@@ -191,8 +191,8 @@ TEST_CASE("a body spun near its intermediate axis flips on time, the paper's for
 // step (velocity and orientation) increases E by up to 1.3e-5 relative in one step (asserted
 // > 1e-6), where kImplicit never does: the implicit option matters.
 // Also checked: the velocity update alone (E formed with the step's starting R). The
-// orientation update R = orth((I + S(w) dt) R_old) also turns w_b slightly (see the [limit]
-// test below); for moments 1:2:3 along x, y, z it removes energy (net E falls with both options).
+// gyroscopic options turn R exactly about w, which leaves w_b as the velocity update made it
+// (the paper's increment would turn it: see the next test).
 TEST_CASE("energy of a tumbling free body never increases with the implicit gyroscopic term",
           "[gyroscopic][law]") {
   const BodyParams params = body_with(kInertia123);
@@ -263,7 +263,7 @@ TEST_CASE("with the implicit term energy never grows for either ordering of the 
 }
 
 // First-order consistency with Euler's equations. Both options are forward or backward Euler
-// in w plus the paper's first-order orientation update, so their global error at a fixed time
+// in w plus an exact turn about w over the step, so their global error at a fixed time
 // is C dt + O(dt^2): halving dt from 2 ms to 1 ms halves it (ratio 2, held to [1.6, 2.5] for the
 // O(dt^2) remainder). A general tumble w_b = (2, 3, 1) rad/s, where the gyroscopic term is
 // large, compared at t = 1 s with the RK4 reference (error < 1e-12, see above). Measured ratios:

@@ -98,9 +98,9 @@ TEST_CASE("no rotation about the grasp axis while the friction circles exceed A_
 // Below A_crit the body swings about the grasp axis as a pendulum with the paper's reduced
 // gravity: small swings have period T = 2 pi sqrt(J_axis / (m g d (1 - A/A_crit))), d = 8 cm
 // the centre's distance from the axis. Released 0.1 rad from hanging straight down, at 500 Hz,
-// the measured period (mean of 4 zero crossings of w_y pairs) is within 2% (the swing's own
-// amplitude lengthens it by ~0.06%, the first-order integration by a little more), and the rod
-// stays in the grasp.
+// the measured period (mean of 3 periods between upward zero crossings of w_y) is within 0.5%:
+// the swing's amplitude lengthens it by 0.06%, the first-order integration and the 2 ms
+// sampling of the crossings by less than 0.3% (measured error 0.05-0.08%); the rod stays held.
 TEST_CASE("below A_crit the grasped body swings about the grasp axis with the reduced gravity",
           "[torsion][law]") {
   const double area = M_PI * 0.008 * 0.008;
@@ -126,7 +126,7 @@ TEST_CASE("below A_crit the grasped body swings about the grasp axis with the re
   const double period = (crossings[3] - crossings[0]) / 3.0;
   const double j_axis = kMass * (0.2 * 0.2 + 0.04 * 0.04) / 12.0 + kMass * 0.08 * 0.08;
   const double expected = 2.0 * M_PI * std::sqrt(j_axis / (kMass * 9.81 * 0.08 * 0.5));
-  CHECK(period == Approx(expected).epsilon(0.02));
+  CHECK(period == Approx(expected).epsilon(0.005));
 }
 
 // Instrumented gimbal (section 3.2, solution 1): above A_crit a pitch change of the gimbal
@@ -144,7 +144,7 @@ TEST_CASE("a gimbal pitch change turns the grasped body about the grasp axis", "
   g.axis = Vec3::UnitY();
   g.area = 2e-4;   // above A_crit
   Vec3 torque(0.1, 0.2, 0.3);
-  const double turned = gimbal_twist(m, g, 0.25, bs, torque);
+  const double turned = gimbal_twist(m, 0, g, 0.25, bs, torque);
   CHECK(turned == 0.25);
   const Mat3 expected = Eigen::AngleAxisd(0.25, Vec3::UnitY()).toRotationMatrix();
   CHECK((bs.rotation - expected).norm() < 1e-15);
@@ -156,7 +156,7 @@ TEST_CASE("a gimbal pitch change turns the grasped body about the grasp axis", "
   BodyState free;
   g.area = 0.5e-4;
   Vec3 t2(0.1, 0.2, 0.3);
-  CHECK(gimbal_twist(m, g, 0.25, free, t2) == 0.0);
+  CHECK(gimbal_twist(m, 0, g, 0.25, free, t2) == 0.0);
   CHECK(free.rotation == Mat3::Identity());
   CHECK(t2 == Vec3(0.1, 0.2, 0.3));
 }
@@ -176,4 +176,100 @@ TEST_CASE("the dead band zeroes torques up to T_crit and leaves larger ones", "[
   Vec3 any(1e-9, 0.0, 0.0);
   dead_band(0.0, any);   // T_crit = 0: no band
   CHECK(any.x() == 1e-9);
+}
+
+// The hinge is about the grasp axis only: the floor still pushes. A 12 x 4 x 4 cm box resting on
+// the floor, pinched lightly across y 4 cm off its centre with A < A_crit, is held up at its far
+// end by the floor: the scaled gravity torque about the axis (m g d / 2 = 0.078 N m) is balanced
+// by the floor's, which needs its far springs (2 x 100 N/m, 0.1 m from the axis) compressed by
+// ~4 mm: a tilt of ~0.04 rad, 0.06 with the first overshoot. So the tilt stays below 0.1 rad
+// (it was 0.46 rad, and the box tore out of the grasp, when the floor's torque about the axis
+// was dropped), the box comes to rest, and the fingers keep it.
+TEST_CASE("a pinched box resting on the floor is not turned through it by the gravity drop",
+          "[torsion][law]") {
+  Model m;
+  m.grasp.torsion = Torsion::kGravityDrop;
+  m.floor.enabled = true;
+  m.floor.material = Material{0.6, 100.0, 1.0};
+  const Vec3 h(0.06, 0.02, 0.02);
+  const double rest = h.z() - 0.4 * 9.81 / 400.0;
+  m.bodies.push_back(graspsim::test::make_box("box", 0.4, h, Vec3(0.0, 0.0, rest), Material{0.8, kInfinity, kInfinity}));
+  m.fingers.push_back(graspsim::test::make_finger("thumb", 300.0, 2.0));
+  m.fingers.push_back(graspsim::test::make_finger("index", 300.0, 2.0));
+  const double squeeze = 0.003;
+  m.grasp.critical_area = 2.0 * M_PI * std::pow(0.8 * squeeze, 2);
+  Simulation sim(m);
+  double worst = 0.0;
+  bool held = true;
+  graspsim::test::run(sim, 3000 * 2,
+                      [&](std::size_t f, double) { return Vec3(-0.04, f == 0 ? -(h.y() - squeeze) : h.y() - squeeze, rest); },
+                      [&](const TickRecord& r) {
+                        if (!r.physics_ran) return;
+                        worst = std::max(worst, std::abs(angle_about_y(r.physics[0].orientation)));
+                        if (r.tick > 300) held = held && r.physics[0].grasp_area > 0.0;
+                      });
+  CHECK(worst < 0.1);
+  CHECK(held);
+  CHECK(sim.state().bodies[0].angular_velocity.norm() < 1e-3);
+}
+
+// Above A_crit the lock holds about any axis, not only a principal one. Fingers pinching the rod
+// at different heights (z = -+1 cm) make the axis skewed in the y-z plane; the rod, without
+// gravity, is set spinning about a general direction, so the finger springs' torques have
+// components that would turn it about u through the off-diagonal inertia (0.26 rad/s leaked
+// before the rate was protected). The rate about u must stay zero: below 1e-6 rad/s, since the
+// check takes u after the step and the rule before it (measured 1.5e-9). At 500 Hz: at 50 Hz this
+// spinning rod's rotation against the finger springs 8 cm away (K/I ~ 7400 s^-2, (w h)^2 ~ 3)
+// is at the explicit stability bound and tears out of the grasp.
+TEST_CASE("the lock above A_crit holds about an axis that is not principal", "[torsion][law]") {
+  const double area = M_PI * 0.008 * 0.008;
+  Model m = rod_scene(Torsion::kGravityDrop, 0.5 * area, 500);
+  m.gravity = Vec3::Zero();
+  m.bodies[0].angular_velocity = Vec3(0.5, 0.3, 0.2);
+  Simulation sim(m);
+  double worst = 0.0;
+  graspsim::test::run(sim, 3000 * 2,
+                      [](std::size_t f, double) { return Vec3(-0.08, f == 0 ? -0.012 : 0.012, f == 0 ? 0.29 : 0.31); },
+                      [&](const TickRecord& r) {
+                        if (!r.physics_ran || r.tick == 0) return;
+                        const State& s = sim.state();
+                        const BodyState& b = s.bodies[0];
+                        const Vec3 g1 = b.rotation * s.fingers[0].god_object + b.position;
+                        const Vec3 g2 = b.rotation * s.fingers[1].god_object + b.position;
+                        const Vec3 u = (g2 - g1).normalized();
+                        // Skewed indeed at the first step (body-frame u near (0, 0.89, 0.45)); the
+                        // god-objects then slide as the rod turns and the axis drifts.
+                        if (r.tick == 6) REQUIRE((b.rotation.transpose() * u).cwiseAbs().maxCoeff() < 0.95);
+                        REQUIRE(r.physics[0].grasp_area > 0.0);   // still held
+                        worst = std::max(worst, std::abs(b.angular_velocity.dot(u)));
+                      });
+  CHECK(worst < 1e-6);
+}
+
+// The gimbal's sense does not depend on the order in which the fingers are listed: the same
+// pitch ramp of the same physical finger turns the body the same way (to rounding, 1e-12).
+TEST_CASE("the gimbal turns the body the same way whatever the finger order", "[torsion][law]") {
+  Mat3 final_rotation[2];
+  for (int order = 0; order < 2; ++order) {
+    Model m = rod_scene(Torsion::kGimbal, 1e-5, 50);
+    m.gravity = Vec3::Zero();
+    if (order == 1) std::swap(m.fingers[0], m.fingers[1]);
+    const int gimbal = order == 0 ? 0 : 1;   // the finger called "thumb", at -y
+    m.grasp.gimbal_finger = gimbal;
+    Simulation sim(m);
+    Input input = make_input(m);
+    TickRecord record = make_tick_record(m);
+    for (int n = 0; n < 3000; ++n) {
+      const double t = sim.time();
+      for (int f = 0; f < 2; ++f) {
+        const bool thumb = m.fingers[f].name == "thumb";
+        input.fingers[f].hip = pinch(thumb ? 0 : 1, 0.008);
+        input.fingers[f].gimbal = Vec3(0.0, thumb ? 0.5 * t : 0.0, 0.0);   // pitch ramp, rad
+      }
+      sim.step(input, record);
+    }
+    final_rotation[order] = sim.state().bodies[0].rotation;
+  }
+  CHECK(Eigen::AngleAxisd(final_rotation[0]).angle() > 0.3);   // it did turn
+  CHECK((final_rotation[0] - final_rotation[1]).norm() < 1e-12);
 }

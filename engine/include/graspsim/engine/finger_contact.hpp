@@ -24,6 +24,18 @@ inline bool friction_circle_step(const Vec3& sp, double radius, Vec3& go) {
   return true;
 }
 
+// The friction circle with static and kinetic friction, for fingers and floor vertices alike.
+// Sticking, the GO moves only when the surface point SP leaves the static circle (then it slips).
+// Slipping, the GO follows SP on the kinetic circle, and the contact sticks again only when SP is
+// within that circle (to 2e-9 of its squared radius: a GO left on the circle must not be kept
+// slipping by rounding) and the relative tangential velocity `v_rel_t` of the finger (or vertex)
+// over the surface does not carry SP away from the GO. Deciding by velocity, not by SP's motion
+// since the last tick, matters at slow physics rates: between two physics steps a body does not
+// move, SP stands still, and a rule on SP alone would re-stick a body sliding through a grip at
+// nine haptic ticks in ten. Returns whether the contact is slipping.
+bool stick_slip_step(const Vec3& sp, double static_radius, double kinetic_radius,
+                     const Vec3& v_rel_t, bool was_slipping, Vec3& go);
+
 // Contact parameters of finger f on body b (or kFloor): the pad and the surface in series.
 ContactPair finger_contact_pair(const Model& model, int finger, int body);
 

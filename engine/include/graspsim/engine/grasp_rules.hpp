@@ -9,37 +9,40 @@
 
 namespace graspsim {
 
-// A body held by exactly two fingers: the axis through their god-objects.
+// A body held by exactly two fingers on opposing faces: the axis through their god-objects.
 struct TwoPointGrasp {
   bool held = false;                  // exactly two fingers touch the body
   int first = -1, second = -1;        // the two fingers, in finger order
   Vec3 go_first{0.0, 0.0, 0.0};       // m, world: god-object of `first`
   Vec3 axis{0.0, 0.0, 0.0};           // 1, world: u, unit, from the first GO to the second
-  double area = 0.0;                  // m^2: A = pi r^2 of the smaller friction circle,
-                                      //      r = mu * depth of the HIP at this tick
+  double area = 0.0;                  // m^2: A = pi r^2 of the smaller friction circle of the
+                                      //      two at the last haptic tick
 };
 
-// The two-point grasp of body b, if exactly two fingers touch it and their god-objects are
-// more than 1 um apart (else `held` is false).
+// The two-point grasp of body b, if exactly two fingers touch it, on faces whose normals oppose,
+// with god-objects more than 1 um apart (else `held` is false).
 TwoPointGrasp two_point_grasp(const Model& model, const State& state, int body);
 
 // Section 3.2, solution 2 (gravity-induced drop). The body turns about the grasp axis as about a
 // hinge through the god-objects (the paper's section 6 suggests taking accelerations about a
 // point near the contacts; about the centre of mass the soft finger springs would have to supply
 // the pivot force and a swinging body tears out of the grasp):
-//   A <  A_crit: w_u += dt T_drop / J_axis with T_drop = [p x m g (1 - A/A_crit)] . u,
-//                p = centre - GO, J_axis the moment of inertia about the axis;
+//   A <  A_crit: w_u += dt T_u / J_axis, T_u = [p x m g (1 - A/A_crit)] . u plus the floor's
+//                torque about the axis, p = centre - GO, J_axis the moment of inertia about the
+//                axis; the dead band applies to T_u as to the residual (section 5);
 //   A >= A_crit: w_u = 0, no rotation about the axis.
-// The residual torque along u is removed, and the velocity corrected so that the axis itself
-// does not move. Returns T_drop (N m; 0 above A_crit).
+// The residual torque is replaced about u, and corrected so that it adds no angular
+// acceleration about u (u need not be a principal axis); the velocity is corrected so that the
+// axis itself does not move. Returns T_u (N m; 0 above A_crit).
 double gravity_drop(const Model& model, int body, const TwoPointGrasp& grasp, double dt,
-                    BodyState& bs, Vec3& torque);
+                    const Vec3& floor_force, const Vec3& floor_torque, BodyState& bs, Vec3& torque);
 
 // Section 3.2, solution 1 (instrumented gimbal): once A > A_crit, the body turns about the axis
 // through the god-objects by the change of the gimbal finger's pitch since the last physics
-// step (positive pitch turns it positively about u); its own rotation rate about that axis is
-// set to zero, as above. Returns the angle turned (rad).
-double gimbal_twist(const Model& model, const TwoPointGrasp& grasp, double pitch_change,
+// step, positively about u for a positive pitch (the caller points u from the gimbal finger to
+// the other, so the sense does not depend on the fingers' order); its own rotation rate about
+// that axis is set to zero, as above. Returns the angle turned (rad).
+double gimbal_twist(const Model& model, int body, const TwoPointGrasp& grasp, double pitch_change,
                     BodyState& bs, Vec3& torque);
 
 // Section 5: T = 0 when |T| <= T_crit.

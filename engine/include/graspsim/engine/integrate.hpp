@@ -16,7 +16,8 @@ void orthonormalize(Mat3& rotation);
 //   a = F / m                       v = v + a dt        p = p + v dt   (the new v: symplectic)
 //   w = w + dw_gyro                 (none for kNeglect, see below)
 //   w_dot = R Jp^-1 R^T T           w = w + w_dot dt
-//   R = (I + S(w) dt) R_old, then orthonormalize(R)
+//   R = (I + S(w) dt) R_old (kNeglect, the paper's increment) or R = exp(S(w) dt) R_old (the exact
+//   turn about w, kExplicit and kImplicit), then orthonormalize(R)
 // The gyroscopic term w x J w of the paper's w_dot = J^-1 (T - w x J w), per `gyroscopic`,
 // with w_b = R_old^T w (body frame) and dw_gyro = R_old dw_b:
 //   kNeglect   dw_b = 0, the paper's approximation for small w or similar principal moments
@@ -30,9 +31,11 @@ void orthonormalize(Mat3& rotation);
 //              dt |w| <= Jmin / (2 Jmax) (derivation in integrate.cpp)
 // kExplicit and kImplicit are first-order accurate for Euler's equations (kNeglect is not
 // consistent with them). Where the computed w_b x Jp w_b is exactly zero (w = 0; a spin about a
-// principal axis when R^T w rounds exactly onto it) all three give the same bits. The orientation update is not an exact turn
-// about w: the n-o-a orthonormalisation turns w_b by O(|w|^2 dt^2) per step, which can add or
-// remove energy depending on the order of the moments along x, y, z (test_gyroscopic.cpp).
+// principal axis when R^T w rounds exactly onto it) all three give the same angular velocity.
+// The paper's orientation increment is not an exact turn about w: with the n-o-a normalisation
+// it turns w_b by O(|w|^2 dt^2) per step, which adds or removes energy depending on the order of
+// the moments along x, y, z; the gyroscopic options therefore turn exactly about w
+// (test_gyroscopic.cpp).
 // The paper writes R = R_old (I + S dt); with w in the world frame (as its w_dot is) the
 // increment belongs on the left: (I + S(w) dt) R_old = R_old (I + S(R_old^T w) dt).
 void integrate_body(const BodyParams& params, Gyroscopic gyroscopic, BodyState& body,

@@ -90,7 +90,7 @@ enum class Gyroscopic {
   kNeglect,    // the paper's approximation for small w: w_dot = R Jp^-1 R^T T
   kExplicit,   // w_dot = J^-1 (T - w x J w), evaluated at the start of the step
   kImplicit,   // one Newton step of implicit Euler on the body-frame Euler equation (no energy
-               // gain from the gyroscopic term)
+               // gain from the gyroscopic term while dt |w| <= J_min / (2 J_max))
 };
 
 // Rotation about the axis through the god-objects of a two-finger grasp (paper, section 3.2).

@@ -28,8 +28,10 @@ struct FingerState {
                                             //    floor), so it rides with the body
   double viscous_force = 0.0;               // N: viscous part of the sliding force at the last
                                             //    haptic tick (the servo force may carry it too)
-  Vec3 surface_point{0.0, 0.0, 0.0};        // m, contact frame: SP at the previous haptic tick
-                                            //    (for the slip speed of viscous friction)
+  double friction_mu = 0.0;                 // 1: friction coefficient applied at the last haptic
+                                            //    tick (mu_s sticking or breaking away, else mu_k)
+  double friction_radius = 0.0;             // m: the friction circle's radius at the last haptic
+                                            //    tick (static or kinetic, as the phase was)
   double pitch_at_last_physics = 0.0;       // rad: gimbal pitch at the previous physics step
   bool has_pitch = false;                   // false until the first physics step
 };
