@@ -105,15 +105,21 @@ void finger_haptic_step(const Model& model, const State& state, const CollisionW
       // sliding force k r is mu_k f_n + c v, v the finger's tangential speed over the surface.
       const ContactPair pair = finger_contact_pair(model, finger, fs.body);
       const bool was_slipping = fs.phase == ContactPhase::kSlip;
-      const Vec3 n_w = fr.R * face.normal;
-      const Vec3 go_w = fr.R * fs.god_object + fr.p;
-      Vec3 v_rel = fs.has_last_haptic ? Vec3((hip - fs.hip_at_last_haptic) * static_cast<double>(model.rates.haptic))
-                                      : Vec3::Zero();
-      if (fs.body >= 0) {
-        const BodyState& bs = state.bodies[fs.body];
-        v_rel -= bs.velocity + bs.angular_velocity.cross(go_w - bs.position);
+      // The finger's tangential velocity over the surface: needed only by a slipping finger
+      // (whether it sticks again) and by viscous friction, so a sticking one skips it.
+      Vec3 v_rel_t = Vec3::Zero();   // m/s, world
+      if (was_slipping || pair.viscous > 0.0) {
+        const Vec3 n_w = fr.R * face.normal;
+        const Vec3 go_w = fr.R * fs.god_object + fr.p;
+        Vec3 v_rel = fs.has_last_haptic
+            ? Vec3((hip - fs.hip_at_last_haptic) * static_cast<double>(model.rates.haptic))
+            : Vec3::Zero();
+        if (fs.body >= 0) {
+          const BodyState& bs = state.bodies[fs.body];
+          v_rel -= bs.velocity + bs.angular_velocity.cross(go_w - bs.position);
+        }
+        v_rel_t = v_rel - v_rel.dot(n_w) * n_w;
       }
-      const Vec3 v_rel_t = v_rel - v_rel.dot(n_w) * n_w;   // m/s, world
       const double viscous = pair.viscous * v_rel_t.norm();  // N, while slipping
       const double kinetic_radius = pair.friction(true) * depth + viscous / pair.stiffness;
       // Steps 3 and 4: move the GO onto the circle only when it lies outside (stick_slip_step

@@ -71,14 +71,21 @@ void keep_axis_rate(const BodyParams& bp, const BodyState& bs, const Vec3& u, Ve
   torque -= alpha.dot(u) * i_u;
 }
 
+// Locks the rotation about the grasp axis: the residual about u removed, the rate about u set
+// to `w_u` as a hinge through the first god-object, and kept through the integration.
+void hinge(const BodyParams& bp, const TwoPointGrasp& grasp, double w_u, BodyState& bs, Vec3& torque) {
+  torque -= torque.dot(grasp.axis) * grasp.axis;
+  set_hinge_rate(grasp.go_first, grasp.axis, w_u, bs);
+  keep_axis_rate(bp, bs, grasp.axis, torque);
+}
+
 }  // namespace
 
 double gravity_drop(const Model& model, int body, const TwoPointGrasp& grasp, double dt,
                     const Vec3& floor_force, const Vec3& floor_torque, BodyState& bs, Vec3& torque) {
   const Vec3& u = grasp.axis;
   const BodyParams& bp = model.bodies[body];
-  torque -= torque.dot(u) * u;   // about u the hinge rule below replaces the residual
-  double turning = 0.0;
+  double turning = 0.0;   // about u the hinge rule replaces the residual
   if (grasp.area < model.grasp.critical_area) {
     // About the axis: the paper's scaled gravity torque, plus what else pushes the body (the
     // floor's torque about the axis point: T_c + (c - GO) x F); the fingers hold the axis.
@@ -90,19 +97,16 @@ double gravity_drop(const Model& model, int body, const TwoPointGrasp& grasp, do
   const double w_u = grasp.area < model.grasp.critical_area
       ? bs.angular_velocity.dot(u) + dt * turning / axis_inertia(bp, bs, grasp.go_first, u)
       : 0.0;
-  set_hinge_rate(grasp.go_first, u, w_u, bs);
-  keep_axis_rate(bp, bs, u, torque);
+  hinge(bp, grasp, w_u, bs, torque);
   return turning;
 }
 
 double gimbal_twist(const Model& model, int body, const TwoPointGrasp& grasp, double pitch_change,
                     BodyState& bs, Vec3& torque) {
   if (!(grasp.area > model.grasp.critical_area)) return 0.0;
-  const Vec3& u = grasp.axis;
-  torque -= torque.dot(u) * u;
-  set_hinge_rate(grasp.go_first, u, 0.0, bs);
-  keep_axis_rate(model.bodies[body], bs, u, torque);
+  hinge(model.bodies[body], grasp, 0.0, bs, torque);
   if (pitch_change == 0.0) return 0.0;
+  const Vec3& u = grasp.axis;
   // Turn the body, orientation and centre, about the axis through the first god-object.
   const Mat3 turn = Eigen::AngleAxisd(pitch_change, u).toRotationMatrix();
   bs.rotation = turn * bs.rotation;
