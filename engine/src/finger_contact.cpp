@@ -35,7 +35,7 @@ bool stick_slip_step(const Vec3& sp, double static_radius, double kinetic_radius
 }
 
 Face pad_face(const Model& model, int finger, int body, int face) {
-  Face f = body >= 0 ? box_face(model.bodies[body].half_extents, face)
+  Face f = body >= 0 ? box_face(model.bodies[body].shape.half_extents, face)
                      : Face{Vec3::UnitZ(), model.floor.height};
   f.offset += model.fingers[finger].radius;
   return f;
@@ -66,7 +66,7 @@ void finger_haptic_step(const Model& model, const State& state, const CollisionW
       const BodyState& bs = state.bodies[b];
       const Vec3 a_b = bs.rotation.transpose() * (a - bs.position);
       const Vec3 hip_b = bs.rotation.transpose() * (hip - bs.position);
-      const Vec3 grown = model.bodies[b].half_extents + Vec3::Constant(r);
+      const Vec3 grown = model.bodies[b].shape.half_extents + Vec3::Constant(r);
       if (const auto e = box_entry(grown, a_b, hip_b); e && e->t < best_t) {
         best_t = e->t;
         fs.body = b;
@@ -97,7 +97,7 @@ void finger_haptic_step(const Model& model, const State& state, const CollisionW
     const Vec3 hip_c = fr.R.transpose() * (hip - fr.p);   // HIP in the contact frame
     // Step 1: the surface point SP, the HIP's projection on the entered face, and the depth.
     const double depth = face.offset - face.normal.dot(hip_c);
-    const bool on_face = fs.body < 0 || within_face(model.bodies[fs.body].half_extents, fs.face, hip_c);
+    const bool on_face = fs.body < 0 || within_face(model.bodies[fs.body].shape.half_extents, fs.face, hip_c);
     if (depth > 0.0 && on_face) {
       const Vec3 sp = hip_c + depth * face.normal;
       // Step 2: friction circle radius = mu * depth: the static coefficient while sticking;

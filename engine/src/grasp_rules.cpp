@@ -44,7 +44,7 @@ TwoPointGrasp two_point_grasp(const Model& model, const State& state, int body) 
   const FingerState& second = state.fingers[g.second];
   // A grasp squeezes from opposite sides: two fingers pressing one face (or adjacent ones)
   // hold nothing between them.
-  const Vec3& h = model.bodies[body].half_extents;
+  const Vec3& h = model.bodies[body].shape.half_extents;
   if (box_face(h, first.face).normal.dot(box_face(h, second.face).normal) >= 0.0) return g;
   const BodyState& bs = state.bodies[body];
   const Vec3 a = bs.rotation * first.god_object + bs.position;

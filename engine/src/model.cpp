@@ -121,7 +121,7 @@ void validate(const Model& model) {
     const std::string f = "objects[" + std::to_string(i + 1) + "] '" + b.name + "'";
     if (b.name.empty()) fail(f, "name must not be empty");
     if (!names.insert(b.name).second) fail(f, "name '" + b.name + "' is used twice");
-    if (!(b.half_extents.minCoeff() > 0.0) || !finite(b.half_extents)) fail(f + ": size", "every side must be > 0 m and finite");
+    if (!(b.shape.half_extents.minCoeff() > 0.0) || !finite(b.shape.half_extents)) fail(f + ": size", "every side must be > 0 m and finite");
     if (!(b.mass > 0.0) || std::isinf(b.mass)) fail(f + ": mass", "must be > 0 kg and finite (got " + str(b.mass) + ")");
     const Vec3& j = b.inertia;
     if (!(j.minCoeff() > 0.0) || !finite(j)) fail(f + ": inertia", "principal moments must be > 0 kg m^2");

@@ -20,7 +20,7 @@ int floor_contact(const Model& model, int body, BodyState& bs, Wrench& out) {
   int touching = 0;
   for (int k = 0; k < 8; ++k) {
     VertexContact& vc = bs.floor_contacts[k];
-    const Vec3 r = bs.rotation * box_vertex(bp.half_extents, k);   // m: from centre of mass
+    const Vec3 r = bs.rotation * box_vertex(bp.shape.half_extents, k);   // m: from centre of mass
     const Vec3 x = bs.position + r;
     const double depth = floor_z - x.z();
     if (depth <= 0.0) {

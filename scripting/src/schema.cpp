@@ -259,9 +259,8 @@ BodyParams object(const LuaValue& value, std::size_t index) {
   }
   if (body.name == "floor") fail(r.at("name"), "'floor' is reserved for the floor");
   if (const LuaValue* shape = r.get("shape")) choice(*shape, r.at("shape"), {"box"}, "shape");
-  body.shape = ShapeKind::kBox;
   const Vec3 size = vec3(r.required("size", "{x, y, z}: the box's full edge lengths in m"), r.at("size"));
-  body.half_extents = size / 2.0;
+  body.shape = box_shape(size / 2.0);
   const LuaValue* mass = r.get("mass");
   const LuaValue* density = r.get("density");
   if (mass != nullptr && density != nullptr) fail(where, "give either mass or density, not both");
@@ -276,9 +275,9 @@ BodyParams object(const LuaValue& value, std::size_t index) {
   } else {
     fail(where, "give its mass (kg) or its density (kg/m^3)");
   }
-  const Vec3 solid = box_inertia(body.mass, body.half_extents);
+  const Vec3 solid = box_inertia(body.mass, body.shape.half_extents);
   if (r.get("inertia") == nullptr && !solid.allFinite() && std::isfinite(body.mass) &&
-      body.half_extents.allFinite()) {
+      body.shape.half_extents.allFinite()) {
     fail(r.at("size"), "too large: the box's moments of inertia overflow");
   }
   body.inertia = r.vec3_or("inertia", solid);

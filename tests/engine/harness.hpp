@@ -15,7 +15,7 @@ inline BodyParams make_box(const std::string& name, double mass, const Vec3& hal
                            const Vec3& position, const Material& material = {}) {
   BodyParams b;
   b.name = name;
-  b.half_extents = half_extents;
+  b.shape = box_shape(half_extents);
   b.mass = mass;
   b.inertia = box_inertia(mass, half_extents);
   b.position = position;

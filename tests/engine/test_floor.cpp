@@ -118,7 +118,7 @@ double floor_energy(const Model& m, const BodyState& s) {
   double e = 0.5 * b.mass * s.velocity.squaredNorm() + 0.5 * w_body.dot(b.inertia.cwiseProduct(w_body)) -
              b.mass * m.gravity.dot(s.position);
   for (int k = 0; k < 8; ++k) {
-    const double depth = m.floor.height - (s.position + s.rotation * box_vertex(b.half_extents, k)).z();
+    const double depth = m.floor.height - (s.position + s.rotation * box_vertex(b.shape.half_extents, k)).z();
     if (depth > 0.0) e += 0.5 * m.floor.material.stiffness * depth * depth;
   }
   return e;

@@ -45,8 +45,8 @@ TEST_CASE("a valid scenario converts to the exact Model values", "[scenario][loa
   REQUIRE(m.bodies.size() == 2);
   const graspsim::BodyParams& box = m.bodies[0];
   CHECK(box.name == "box");
-  CHECK(box.shape == graspsim::ShapeKind::kBox);
-  CHECK(box.half_extents == Vec3(0.04, 0.03, 0.02));
+  CHECK(box.shape.kind == graspsim::ShapeKind::kBox);
+  CHECK(box.shape.half_extents == Vec3(0.04, 0.03, 0.02));
   CHECK(box.mass == 0.4);
   CHECK(box.inertia == box_inertia(0.4, Vec3(0.04, 0.03, 0.02)));   // the default inertia
   CHECK(box.position == Vec3(0, 0, 0.02));
@@ -104,7 +104,7 @@ TEST_CASE("fields left out take the documented defaults", "[scenario][load]") {
   CHECK(m.gravity == Vec3(0, 0, -9.81));
   CHECK_FALSE(m.floor.enabled);
   REQUIRE(m.bodies.size() == 1);
-  CHECK(m.bodies[0].half_extents == Vec3(0.05, 0.05, 0.05));
+  CHECK(m.bodies[0].shape.half_extents == Vec3(0.05, 0.05, 0.05));
   CHECK(m.bodies[0].inertia == box_inertia(1.0, Vec3(0.05, 0.05, 0.05)));
   CHECK(m.bodies[0].position == Vec3::Zero());
   REQUIRE(m.fingers.size() == 1);

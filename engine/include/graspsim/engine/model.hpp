@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "graspsim/engine/math.hpp"
+#include "graspsim/engine/shape.hpp"
 
 namespace graspsim {
 
@@ -55,12 +56,9 @@ struct ContactPair {
 };
 ContactPair contact_pair(const Material& a, const Material& b);
 
-enum class ShapeKind { kBox };
-
 struct BodyParams {
   std::string name;
-  ShapeKind shape = ShapeKind::kBox;
-  Vec3 half_extents{0.05, 0.05, 0.05};          // m: box half sizes along body x, y, z
+  Shape shape = box_shape(Vec3(0.05, 0.05, 0.05));   // in the body frame
   double mass = 1.0;                            // kg
   Vec3 inertia{1.0, 1.0, 1.0};                  // kg m^2: principal moments Jp (body axes)
   Material material;
