@@ -2,6 +2,8 @@
 // god-object is constrained to is exact and analytic.
 #include "graspsim/engine/collision.hpp"
 
+#include "fcl_shape.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -91,9 +93,7 @@ struct CollisionWorld::Impl {
 CollisionWorld::CollisionWorld(const Model& model) : impl_(std::make_unique<Impl>()) {
   std::vector<fcl::CollisionObjectd*> objects;
   for (std::size_t i = 0; i < model.bodies.size(); ++i) {
-    const Vec3 size = 2.0 * model.bodies[i].shape.half_extents;
-    auto shape = std::make_shared<fcl::Boxd>(size.x(), size.y(), size.z());
-    impl_->bodies.push_back(std::make_unique<fcl::CollisionObjectd>(shape));
+    impl_->bodies.push_back(std::make_unique<fcl::CollisionObjectd>(detail::fcl_geometry(model.bodies[i].shape)));
     impl_->bodies.back()->setUserData(reinterpret_cast<void*>(static_cast<std::intptr_t>(i + 1)));
     objects.push_back(impl_->bodies.back().get());
   }
