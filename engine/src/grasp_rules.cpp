@@ -79,25 +79,44 @@ void hinge(const BodyParams& bp, const TwoPointGrasp& grasp, double w_u, BodySta
   keep_axis_rate(bp, bs, grasp.axis, torque);
 }
 
+// Turns the body, orientation and centre, by `angle` about the grasp axis through the first
+// god-object (a rigid turn: the points on the axis stay put).
+void turn_about_axis(const TwoPointGrasp& grasp, double angle, BodyState& bs) {
+  if (angle == 0.0) return;
+  const Mat3 turn = Eigen::AngleAxisd(angle, grasp.axis).toRotationMatrix();
+  bs.rotation = turn * bs.rotation;
+  bs.position = grasp.go_first + turn * (bs.position - grasp.go_first);
+}
+
 }  // namespace
 
 double gravity_drop(const Model& model, int body, const TwoPointGrasp& grasp, double dt,
-                    const Vec3& floor_force, const Vec3& floor_torque, BodyState& bs, Vec3& torque) {
+                    const Vec3& floor_force, const Vec3& floor_torque, BodyState& bs, Vec3& torque,
+                    double& turned) {
   const Vec3& u = grasp.axis;
   const BodyParams& bp = model.bodies[body];
-  double turning = 0.0;   // about u the hinge rule replaces the residual
-  if (grasp.area < model.grasp.critical_area) {
-    // About the axis: the paper's scaled gravity torque, plus what else pushes the body (the
-    // floor's torque about the axis point: T_c + (c - GO) x F); the fingers hold the axis.
-    const Vec3 p = bs.position - grasp.go_first;   // from a contact point to the centre of mass
-    const double drop = p.cross(bp.mass * model.gravity * (1.0 - grasp.area / model.grasp.critical_area)).dot(u);
-    turning = drop + (floor_torque + p.cross(floor_force)).dot(u);
-    if (std::abs(turning) <= model.grasp.dead_band) turning = 0.0;   // section 5, about u too
+  const double c_t = model.grasp.torsional_damping;
+  turned = 0.0;
+  if (!(grasp.area < model.grasp.critical_area)) {   // the pads hold: no rotation about u
+    hinge(bp, grasp, 0.0, bs, torque);
+    return 0.0;
   }
-  const double w_u = grasp.area < model.grasp.critical_area
-      ? bs.angular_velocity.dot(u) + dt * turning / axis_inertia(bp, bs, grasp.go_first, u)
-      : 0.0;
-  hinge(bp, grasp, w_u, bs, torque);
+  // About the axis: the paper's scaled gravity torque, plus what else pushes the body (the
+  // floor's torque about the axis point: T_c + (c - GO) x F); the fingers hold the axis.
+  const Vec3 p = bs.position - grasp.go_first;   // from a contact point to the centre of mass
+  const double drop = p.cross(bp.mass * model.gravity * (1.0 - grasp.area / model.grasp.critical_area)).dot(u);
+  double turning = drop + (floor_torque + p.cross(floor_force)).dot(u);
+  if (std::abs(turning) <= model.grasp.dead_band) turning = 0.0;   // section 5, about u too
+  if (c_t > 0.0) {
+    // Quasi-static: the pads' torsional friction sets the rate, T_u / c_t, and the step turns the
+    // body by dt T_u / c_t about the axis, exactly (no rate is left about u to carry over).
+    hinge(bp, grasp, 0.0, bs, torque);
+    turned = dt * turning / c_t;
+    turn_about_axis(grasp, turned, bs);
+    return turning;
+  }
+  // Inertial: the rate about the axis integrates T_u over the inertia about the axis.
+  hinge(bp, grasp, bs.angular_velocity.dot(u) + dt * turning / axis_inertia(bp, bs, grasp.go_first, u), bs, torque);
   return turning;
 }
 
@@ -106,11 +125,7 @@ double gimbal_twist(const Model& model, int body, const TwoPointGrasp& grasp, do
   if (!(grasp.area > model.grasp.critical_area)) return 0.0;
   hinge(model.bodies[body], grasp, 0.0, bs, torque);
   if (pitch_change == 0.0) return 0.0;
-  const Vec3& u = grasp.axis;
-  // Turn the body, orientation and centre, about the axis through the first god-object.
-  const Mat3 turn = Eigen::AngleAxisd(pitch_change, u).toRotationMatrix();
-  bs.rotation = turn * bs.rotation;
-  bs.position = grasp.go_first + turn * (bs.position - grasp.go_first);
+  turn_about_axis(grasp, pitch_change, bs);
   return pitch_change;
 }
 

@@ -111,6 +111,10 @@ void validate(const Model& model) {
          "\"gimbal\" and only then");
   if (!(g.dead_band >= 0.0) || std::isinf(g.dead_band))
     fail("grasp.dead_band", "must be >= 0 N m and finite (got " + str(g.dead_band) + ")");
+  if (!(g.torsional_damping >= 0.0) || std::isinf(g.torsional_damping))
+    fail("grasp.torsional_damping", "must be >= 0 N m s/rad and finite (got " + str(g.torsional_damping) + ")");
+  if (g.torsional_damping > 0.0 && g.torsion != Torsion::kGravityDrop)
+    fail("grasp.torsional_damping", "applies with grasp.torsion = \"gravity_drop\" only");
   if (model.floor.enabled) {
     check_material("floor.material", model.floor.material);
     if (!std::isfinite(model.floor.height)) fail("floor.height", "must be finite");

@@ -98,7 +98,8 @@ void Simulation::step(const Input& input, TickRecord& record) {
         if (grasp.held) {
           rec.grasp_area = grasp.area;
           if (model_.grasp.torsion == Torsion::kGravityDrop) {
-            rec.torsion = gravity_drop(model_, static_cast<int>(b), grasp, dt, floor.force, floor.torque, bs, torque);
+            rec.torsion = gravity_drop(model_, static_cast<int>(b), grasp, dt, floor.force, floor.torque, bs, torque,
+                                       rec.twist);
           } else if (grasp.first == model_.grasp.gimbal_finger || grasp.second == model_.grasp.gimbal_finger) {
             TwoPointGrasp toward_other = grasp;   // u from the gimbal finger to the other one
             if (grasp.second == model_.grasp.gimbal_finger) toward_other.axis = -grasp.axis;

@@ -385,7 +385,8 @@ const std::vector<std::string>& fields_of(TableKind kind) {
   static const std::vector<std::string> kRoot = {
       "name", "description", "duration", "seed", "rates", "gravity", "gyroscopic",
       "grasp", "floor", "objects", "fingers", "expect"};
-  static const std::vector<std::string> kGrasp = {"torsion", "critical_area", "gimbal_finger", "dead_band"};
+  static const std::vector<std::string> kGrasp = {"torsion", "critical_area", "gimbal_finger", "dead_band",
+                                                      "torsional_damping"};
   static const std::vector<std::string> kRates = {"servo", "haptic", "physics"};
   static const std::vector<std::string> kFloor = {"height", "material"};
   static const std::vector<std::string> kMaterial = {"mu", "mu_kinetic", "stiffness", "damping", "viscous"};
@@ -529,6 +530,7 @@ ScenarioParts convert_scenario(const LuaValue& root, const std::string& default_
     }
     out.critical_area = g.number_or("critical_area", out.critical_area);
     out.dead_band = g.number_or("dead_band", out.dead_band);
+    out.torsional_damping = g.number_or("torsional_damping", out.torsional_damping);
     if (const LuaValue* f = g.get("gimbal_finger")) {
       const std::string name = string_value(*f, g.at("gimbal_finger"));
       for (std::size_t i = 0; i < s.model.fingers.size(); ++i) {

@@ -30,12 +30,18 @@ TwoPointGrasp two_point_grasp(const Model& model, const State& state, int body);
 //   A <  A_crit: w_u += dt T_u / J_axis, T_u = [p x m g (1 - A/A_crit)] . u plus the floor's
 //                torque about the axis, p = centre - GO, J_axis the moment of inertia about the
 //                axis; the dead band applies to T_u as to the residual (section 5);
+//                with the pads' torsional friction c_t > 0 (grasp.torsional_damping) the turn
+//                is quasi-static instead: the body is turned by dt T_u / c_t about the axis
+//                (rigidly, as by the gimbal) and keeps no rate about u, so a torque in the
+//                dead band stops it (section 5; see engine/README.md);
 //   A >= A_crit: w_u = 0, no rotation about the axis.
 // The residual torque is replaced about u, and corrected so that it adds no angular
 // acceleration about u (u need not be a principal axis); the velocity is corrected so that the
-// axis itself does not move. Returns T_u (N m; 0 above A_crit).
+// axis itself does not move. Returns T_u (N m; 0 above A_crit); `turned` (rad) is the
+// quasi-static turn of this step (0 when inertial).
 double gravity_drop(const Model& model, int body, const TwoPointGrasp& grasp, double dt,
-                    const Vec3& floor_force, const Vec3& floor_torque, BodyState& bs, Vec3& torque);
+                    const Vec3& floor_force, const Vec3& floor_torque, BodyState& bs, Vec3& torque,
+                    double& turned);
 
 // Section 3.2, solution 1 (instrumented gimbal): once A > A_crit, the body turns about the axis
 // through the god-objects by the change of the gimbal finger's pitch since the last physics

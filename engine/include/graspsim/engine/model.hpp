@@ -106,6 +106,10 @@ struct GraspParams {
   int gimbal_finger = -1;       // index into Model::fingers whose gimbal pitch turns the body
   double dead_band = 0.0;       // N m: T_crit; a residual torque |T| <= T_crit is set to zero
                                 //      (paper, section 5), 0 for none
+  double torsional_damping = 0.0;   // N m s/rad: c_t, the finger pads' torsional friction about
+                                    //      the grasp axis with gravity drop; > 0 makes the turn
+                                    //      quasi-static, w_u = T_u / c_t each physics step (see
+                                    //      engine/README.md); 0: the inertial swing w_u += dt T_u / J
 };
 
 struct Model {

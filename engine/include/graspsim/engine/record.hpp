@@ -49,7 +49,8 @@ struct BodyRecord {
   double grasp_area = 0.0;                // m^2: friction-circle area A of a two-finger grasp
                                           //      (0 when not held by exactly two fingers)
   double torsion = 0.0;                   // N m: gravity-drop torque about the grasp axis
-  double twist = 0.0;                     // rad: turned about the grasp axis by the gimbal
+  double twist = 0.0;                     // rad: turned about the grasp axis by the gimbal or
+                                          //      the quasi-static gravity drop
 };
 
 struct TickRecord {
