@@ -11,7 +11,8 @@
 -- 2)) = 1.0 s): released level, it passes the bottom after about 0.3 s and rises level on the
 -- other side, and swings on, undamped, since the paper's torque has no torsional loss. The
 -- fingers stick throughout. Try --set grasp.critical_area=1e-4 (below A: the pads hold the rod
--- level, and the first expectation fails) or --set rates.physics=500.
+-- level, and the first expectation fails) or --set rates.physics=500. With the pads' torsional
+-- friction (grasp.torsional_damping) the turn is quasi-static instead: see dead_band.lua.
 
 local squeeze = param("squeeze", 0.008)   -- m: how far each finger presses in
 local half = { 0.10, 0.02, 0.02 }         -- m
