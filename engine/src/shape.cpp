@@ -86,7 +86,13 @@ std::string str(double v) {
   return s.str();
 }
 
-std::string edge_str(int a, int b) { return std::to_string(a) + " -> " + std::to_string(b); }
+std::string point_str(const Vec3& v) { return "(" + str(v.x()) + ", " + str(v.y()) + ", " + str(v.z()) + ")"; }
+
+// "3 -> 7 at (0, 0, 0) -> (1, 0, 0)": indices count from 0; the positions find it in a file.
+std::string edge_str(const TriangleMesh& m, int a, int b) {
+  return std::to_string(a) + " -> " + std::to_string(b) + " at " + point_str(m.vertices[a]) + " -> " +
+         point_str(m.vertices[b]);
+}
 
 // The length of the diagonal of the mesh's bounding box (m), the scale of its tolerances.
 double mesh_size(const TriangleMesh& m) {
@@ -208,7 +214,7 @@ void check_closed_mesh(const TriangleMesh& m) {
       const int a = tri[i], b = tri[(i + 1) % 3];
       const auto [it, fresh] = edges.emplace(std::make_pair(a, b), t);
       if (!fresh) {
-        throw MeshError("triangle " + std::to_string(t) + ": edge " + edge_str(a, b) +
+        throw MeshError("triangle " + std::to_string(t) + ": edge " + edge_str(m, a, b) +
                         " runs the same way as in triangle " + std::to_string(it->second) +
                         ": the triangles are not consistently oriented (or more than two share "
                         "the edge)", t);
@@ -217,7 +223,7 @@ void check_closed_mesh(const TriangleMesh& m) {
   }
   for (const auto& [edge, t] : edges) {
     if (edges.find({edge.second, edge.first}) == edges.end()) {
-      throw MeshError("triangle " + std::to_string(t) + ": edge " + edge_str(edge.first, edge.second) +
+      throw MeshError("triangle " + std::to_string(t) + ": edge " + edge_str(m, edge.first, edge.second) +
                       " has no neighbouring triangle: the mesh is not closed", t);
     }
   }
@@ -274,7 +280,7 @@ ConvexPolyhedron convex_polyhedron(const TriangleMesh& mesh) {
     for (std::size_t v = 0; v < m.vertices.size(); ++v) {
       const double out = used[v] ? normal[t].dot(m.vertices[v]) - offset : 0.0;
       if (out > tol) {
-        throw MeshError("the mesh is not convex: vertex " + std::to_string(v) + " lies " + str(out) +
+        throw MeshError("the mesh is not convex: vertex " + std::to_string(v) + " " + point_str(m.vertices[v]) + " lies " + str(out) +
                         " m outside the plane of triangle " + std::to_string(t), t);
       }
     }
