@@ -32,6 +32,39 @@ void check_material(const std::string& field, const Material& m) {
 
 bool finite(const Vec3& v) { return v.allFinite(); }
 
+// The fields each shape kind uses, by the scenario's names (size, radius, length, file).
+void check_shape(const std::string& f, const Shape& s) {
+  const auto positive = [&](const char* field, double v, const char* what) {
+    if (!(v > 0.0) || std::isinf(v)) fail(f + ": " + field, std::string(what) + " must be > 0 m and finite (got " + str(v) + ")");
+  };
+  switch (s.kind) {
+    case ShapeKind::kBox:
+      if (!(s.half_extents.minCoeff() > 0.0) || !finite(s.half_extents)) fail(f + ": size", "every side must be > 0 m and finite");
+      if (!s.hull) fail(f + ": shape", "a box needs its faces (use box_shape())");
+      return;
+    case ShapeKind::kSphere:
+      positive("radius", s.radius, "the radius");
+      return;
+    case ShapeKind::kCylinder:
+    case ShapeKind::kCapsule:
+      positive("radius", s.radius, "the radius");
+      if (s.kind == ShapeKind::kCylinder) {
+        positive("length", 2.0 * s.half_length, "a cylinder's length");
+      } else if (!(s.half_length >= 0.0) || std::isinf(s.half_length)) {
+        fail(f + ": length", "a capsule's length (of its cylinder part) must be >= 0 m and finite (got " + str(2.0 * s.half_length) + ")");
+      }
+      return;
+    case ShapeKind::kConvex:
+    case ShapeKind::kMesh:
+      if (!s.mesh || s.mesh->triangles.empty()) fail(f + ": file", "the shape has no triangles");
+      if (s.kind == ShapeKind::kConvex && (!s.hull || s.hull->faces.empty())) {
+        fail(f + ": file", "a convex shape needs its faces (use convex_shape())");
+      }
+      return;
+  }
+  fail(f + ": shape", "unknown shape kind");
+}
+
 }  // namespace
 
 // Springs in series add compliances; dampers in series add "mobilities" (1/c). An infinite
@@ -125,7 +158,7 @@ void validate(const Model& model) {
     const std::string f = "objects[" + std::to_string(i + 1) + "] '" + b.name + "'";
     if (b.name.empty()) fail(f, "name must not be empty");
     if (!names.insert(b.name).second) fail(f, "name '" + b.name + "' is used twice");
-    if (!(b.shape.half_extents.minCoeff() > 0.0) || !finite(b.shape.half_extents)) fail(f + ": size", "every side must be > 0 m and finite");
+    check_shape(f, b.shape);
     if (!(b.mass > 0.0) || std::isinf(b.mass)) fail(f + ": mass", "must be > 0 kg and finite (got " + str(b.mass) + ")");
     const Vec3& j = b.inertia;
     if (!(j.minCoeff() > 0.0) || !finite(j)) fail(f + ": inertia", "principal moments must be > 0 kg m^2");

@@ -114,7 +114,8 @@ Scenario Scenario::load(const std::string& path, const LoadOptions& options) {
     // Copy the final table out (functions referenced) and convert it.
     const detail::LuaValue table = detail::read_value(state, root, &lua);
     lua_settop(state, top);
-    detail::ScenarioParts parts = detail::convert_scenario(table, default_name(path));
+    detail::ScenarioParts parts = detail::convert_scenario(
+        table, default_name(path), std::filesystem::path(path).parent_path().string());
     s.parameters_ = detail::flatten_parameters(table, params);
     s.name_ = std::move(parts.name);
     s.description_ = std::move(parts.description);

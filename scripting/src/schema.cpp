@@ -3,10 +3,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <limits>
 #include <set>
 #include <stdexcept>
 
+#include "mesh_file.hpp"
 #include "messages.hpp"
 
 namespace graspsim::scripting::detail {
@@ -248,7 +250,7 @@ FloorParams read_floor(const LuaValue* value) {
   return floor;
 }
 
-BodyParams object(const LuaValue& value, std::size_t index) {
+BodyParams object(const LuaValue& value, std::size_t index, const std::string& base_dir) {
   const Where where{element_label("objects", index, value, "name"), ""};
   const Record r(value, where, TableKind::kObject);
   BodyParams body;
@@ -258,32 +260,94 @@ BodyParams object(const LuaValue& value, std::size_t index) {
                        "starting with a digit)");
   }
   if (body.name == "floor") fail(r.at("name"), "'floor' is reserved for the floor");
-  if (const LuaValue* shape = r.get("shape")) choice(*shape, r.at("shape"), {"box"}, "shape");
-  const Vec3 size = vec3(r.required("size", "{x, y, z}: the box's full edge lengths in m"), r.at("size"));
-  body.shape = box_shape(size / 2.0);
+  const std::string kind = r.get("shape") == nullptr ? "box"
+      : choice(*r.get("shape"), r.at("shape"), {"box", "sphere", "cylinder", "capsule", "convex", "mesh"}, "shape");
+  // Each kind takes its own fields and no other's.
+  const std::vector<std::string> takes =
+      kind == "box" ? std::vector<std::string>{"size"}
+      : kind == "sphere" ? std::vector<std::string>{"radius"}
+      : kind == "cylinder" || kind == "capsule" ? std::vector<std::string>{"radius", "length"}
+      : std::vector<std::string>{"file", "scale"};
+  for (const char* field : {"size", "radius", "length", "file", "scale"}) {
+    if (r.get(field) != nullptr && std::find(takes.begin(), takes.end(), field) == takes.end()) {
+      fail(r.at(field), "does not apply to shape = \"" + kind + "\" (it takes " + join(takes, " and ") + ")");
+    }
+  }
   const LuaValue* mass = r.get("mass");
   const LuaValue* density = r.get("density");
   if (mass != nullptr && density != nullptr) fail(where, "give either mass or density, not both");
-  if (mass != nullptr) {
-    body.mass = number(*mass, r.at("mass"));
-  } else if (density != nullptr) {
-    const double rho = number(*density, r.at("density"));
+  if (mass == nullptr && density == nullptr) fail(where, "give its mass (kg) or its density (kg/m^3)");
+  double rho = 0.0;
+  if (density != nullptr) {
+    rho = number(*density, r.at("density"));
     if (!(rho > 0.0) || std::isinf(rho)) {
       fail(r.at("density"), "must be > 0 kg/m^3 and finite (got " + format_short(rho) + ")");
     }
-    body.mass = rho * size.x() * size.y() * size.z();
+  }
+  // The file frame of a mesh: x_file = frame.centre + frame.rotation x_body.
+  PrincipalFrame frame;
+  const bool from_file = kind == "convex" || kind == "mesh";
+  if (kind == "box") {
+    const Vec3 size = vec3(r.required("size", "{x, y, z}: the box's full edge lengths in m"), r.at("size"));
+    body.shape = box_shape(size / 2.0);
+    body.mass = mass != nullptr ? number(*mass, r.at("mass")) : rho * size.x() * size.y() * size.z();
+    const Vec3 solid = box_inertia(body.mass, body.shape.half_extents);
+    if (r.get("inertia") == nullptr && !solid.allFinite() && std::isfinite(body.mass) &&
+        body.shape.half_extents.allFinite()) {
+      fail(r.at("size"), "too large: the box's moments of inertia overflow");
+    }
+    body.inertia = solid;
   } else {
-    fail(where, "give its mass (kg) or its density (kg/m^3)");
+    if (from_file) {
+      const std::string name = string_value(r.required("file", "the OBJ or STL file, relative to the scenario"), r.at("file"));
+      const double scale = r.number_or("scale", 1.0);
+      if (!(scale > 0.0) || std::isinf(scale)) {
+        fail(r.at("scale"), "must be > 0 and finite (got " + format_short(scale) + ")");
+      }
+      const std::filesystem::path given(name);
+      const std::string path = given.is_absolute() || base_dir.empty() ? name : (std::filesystem::path(base_dir) / given).string();
+      MeshFile file;
+      try {
+        file = read_mesh_file(path);
+      } catch (const ConversionError& e) {
+        fail(r.at("file"), e.what());
+      }
+      for (Vec3& v : file.mesh.vertices) v *= scale;
+      try {
+        // Checked in the file's frame first, so that positions in messages are the file's.
+        if (kind == "convex") convex_polyhedron(file.mesh);
+        TriangleMesh body_mesh = to_principal_frame(file.mesh, frame);
+        body.shape = kind == "convex" ? convex_shape(std::move(body_mesh)) : mesh_shape(std::move(body_mesh));
+      } catch (const MeshError& e) {
+        fail(r.at("file"), mesh_location(file, path, e.triangle()) + e.what() +
+                               (kind == "convex" && std::string(e.what()).find("not convex") != std::string::npos
+                                    ? " (use shape = \"mesh\" for a non-convex solid)" : ""));
+      }
+    } else {
+      const double radius = number(r.required("radius", "m"), r.at("radius"));
+      if (kind == "sphere") {
+        body.shape = sphere_shape(radius);
+      } else {
+        const double length = number(r.required("length", "m: the length of the cylinder (part), along body z"), r.at("length"));
+        body.shape = kind == "cylinder" ? cylinder_shape(radius, length / 2.0) : capsule_shape(radius, length / 2.0);
+      }
+    }
+    // Mass properties of the unit-density solid, scaled to the density or the given mass.
+    const MassProperties unit = mass_properties(body.shape, 1.0);
+    const Vec3 moments = from_file ? frame.moments : Vec3(unit.inertia.diagonal());
+    body.mass = mass != nullptr ? number(*mass, r.at("mass")) : rho * unit.mass;
+    body.inertia = moments * (body.mass / unit.mass);
   }
-  const Vec3 solid = box_inertia(body.mass, body.shape.half_extents);
-  if (r.get("inertia") == nullptr && !solid.allFinite() && std::isfinite(body.mass) &&
-      body.shape.half_extents.allFinite()) {
-    fail(r.at("size"), "too large: the box's moments of inertia overflow");
-  }
-  body.inertia = r.vec3_or("inertia", solid);
+  body.inertia = r.vec3_or("inertia", body.inertia);
   if (const LuaValue* m = r.get("material")) body.material = material(*m, r.at("material"), Material{});
   body.position = r.vec3_or("position", body.position);
   if (const LuaValue* q = r.get("orientation")) body.orientation = quaternion(*q, r.at("orientation"));
+  if (from_file) {
+    // position and orientation place the file's frame; the body sits at the centre of mass,
+    // along the principal axes.
+    body.position += body.orientation * frame.centre;
+    body.orientation = (body.orientation * Quat(frame.rotation)).normalized();
+  }
   body.velocity = r.vec3_or("velocity", body.velocity);
   body.angular_velocity = r.vec3_or("angular_velocity", body.angular_velocity);
   return body;
@@ -391,8 +455,8 @@ const std::vector<std::string>& fields_of(TableKind kind) {
   static const std::vector<std::string> kFloor = {"height", "material"};
   static const std::vector<std::string> kMaterial = {"mu", "mu_kinetic", "stiffness", "damping", "viscous"};
   static const std::vector<std::string> kObject = {
-      "name", "shape", "size", "mass", "density", "inertia", "position", "orientation",
-      "velocity", "angular_velocity", "material"};
+      "name", "shape", "size", "radius", "length", "file", "scale", "mass", "density", "inertia",
+      "position", "orientation", "velocity", "angular_velocity", "material"};
   static const std::vector<std::string> kFinger = {
       "name", "stiffness", "damping", "radius", "max_force", "trajectory", "interpolation"};
   static const std::vector<std::string> kWaypoint = {"t", "p"};
@@ -481,7 +545,8 @@ std::string element_segment(TableKind array, const LuaValue& table, std::size_t 
 // ---------------------------------------------------------------------------------------------
 // The whole scenario.
 
-ScenarioParts convert_scenario(const LuaValue& root, const std::string& default_name) {
+ScenarioParts convert_scenario(const LuaValue& root, const std::string& default_name,
+                               const std::string& base_dir) {
   if (!root.is_table()) {
     throw ConversionError("the scenario must return a table (return { duration = ..., objects = "
                           "..., fingers = ... }), but it returned " + root.type_name());
@@ -508,7 +573,7 @@ ScenarioParts convert_scenario(const LuaValue& root, const std::string& default_
 
   if (const LuaValue* objects = r.get("objects")) {
     const auto elements = array(*objects, r.at("objects"), "an array of objects { {name = ...}, ... }");
-    for (std::size_t i = 0; i < elements.size(); ++i) s.model.bodies.push_back(object(*elements[i], i + 1));
+    for (std::size_t i = 0; i < elements.size(); ++i) s.model.bodies.push_back(object(*elements[i], i + 1, base_dir));
   }
   if (const LuaValue* fingers = r.get("fingers")) {
     const auto elements = array(*fingers, r.at("fingers"), "an array of fingers { {name = ...}, ... }");

@@ -55,8 +55,10 @@ struct ScenarioParts {
 };
 
 // Checks and converts the scenario table. Functions in it must carry registry references.
-// `default_name` is used when the table has no name.
-ScenarioParts convert_scenario(const LuaValue& root, const std::string& default_name);
+// `default_name` is used when the table has no name; mesh files are found relative to
+// `base_dir` (the scenario file's directory; "" for the working directory).
+ScenarioParts convert_scenario(const LuaValue& root, const std::string& default_name,
+                               const std::string& base_dir = "");
 
 // Every value of the table except functions, and every value param() returned (`params`, by
 // name), as sorted "path = value" lines with the paths --set takes

@@ -134,8 +134,8 @@ TEST_CASE("bad values are named with their field (the engine's validate() and th
   CHECK_THAT(quaternion.message, StartsWith(quaternion.path + ": objects[2] 'lid': orientation: must be a unit quaternion"));
   const Broken times = broken("waypoints_out_of_order", "{t = 2, p = {0.03, 0, 0.1}}", "{t = 1, p = {0.03, 0, 0.1}}");
   CHECK_THAT(times.message, StartsWith(times.path + ": fingers[2] 'index': trajectory[3].t: 1 s does not come after"));
-  const Broken shape = broken("unknown_shape", "shape = \"box\"", "shape = \"sphere\"");
-  CHECK(shape.message == shape.path + ": objects[1] 'box': shape: unknown shape 'sphere' (supported shapes: box)");
+  const Broken shape = broken("unknown_shape", "shape = \"box\"", "shape = \"sphre\"");
+  CHECK(shape.message == shape.path + ": objects[1] 'box': shape: unknown shape 'sphre' (did you mean 'sphere'?)");
   const Broken interpolation = broken("unknown_interpolation", "\"linear\"", "\"lnear\"");
   CHECK(interpolation.message == interpolation.path +
         ": fingers[2] 'index': interpolation: unknown interpolation 'lnear' (did you mean 'linear'?)");
