@@ -90,12 +90,13 @@ TEST_CASE("a trajectory function that returns no finite x, y, z is an error nami
   auto pinky = s.make_trajectory(3);
   CHECK(error_of([&] { pinky->position(0.5); }) ==
         path + ": fingers[4] 'pinky' trajectory at t = 0.5 s: the function must return x, y, z (m) "
-               "or {x, y, z}, but returned (string, number, number)");
+               "and optionally the gimbal pitch (rad), or {x, y, z[, pitch]}, but returned "
+               "(string, number, number)");
   CHECK(error_of([&] { pinky->position(1.5); }) ==
         path + ": fingers[4] 'pinky' trajectory at t = 1.5 s: the function returned a non-finite "
                "position (nan, 0, 0)");
   CHECK_THAT(error_of([&] { pinky->position(2.5); }),
-             Contains("but returned a table that is not {x, y, z} (2 elements)"));
+             Contains("but returned a table that is not {x, y, z} or {x, y, z, pitch} (2 elements)"));
 }
 
 TEST_CASE("an endless loop in a trajectory function stops with the per-call budget message",
