@@ -231,38 +231,58 @@ int param_type_error(lua_State* state, const Override& chosen, const char* name,
 // one function fills both a fresh `sim` for a check and the persistent view trajectories read.
 // In the view every table is behind a read-only proxy (below); open() looks through it.
 
+// Where write_state() finds the tables it writes into: by key (looking through read-only
+// proxies; a check's fresh `sim`, and the view's first update, which also lists every table it
+// opens, in order, in the table at `list`), or, for the view's later updates, from that list in
+// the same order: one lua_rawgeti per table instead of a key lookup and a proxy.
+struct Tables {
+  int list = 0;         // absolute stack index of the list of tables, or 0
+  bool record = false;  // true: open by key and append to the list; false: take from the list
+  lua_Integer next = 0; // tables taken or appended so far
+};
+
 // The table under the key at the top of the stack in the table at absolute index `parent`:
 // replaces the key with it (the data behind a read-only proxy), creating it if absent.
-void open(lua_State* state, int parent, int narray, int nrecord) {
+void open(lua_State* state, int parent, int narray, int nrecord, Tables& tables) {
   lua_pushvalue(state, -1);
   lua_rawget(state, parent);   // key value
   if (lua_type(state, -1) == LUA_TTABLE) {
     lua_remove(state, -2);
-    return;
-  }
-  if (lua_type(state, -1) == LUA_TUSERDATA && lua_getmetatable(state, -1)) {   // key proxy mt
+  } else if (lua_type(state, -1) == LUA_TUSERDATA && lua_getmetatable(state, -1)) {   // key proxy mt
     lua_pushliteral(state, "__index");
     lua_rawget(state, -2);     // key proxy mt data
     lua_replace(state, -4);
     lua_pop(state, 2);
+  } else {
+    lua_pop(state, 1);
+    lua_createtable(state, narray, nrecord);   // key table
+    lua_pushvalue(state, -2);
+    lua_pushvalue(state, -2);
+    lua_rawset(state, parent);
+    lua_remove(state, -2);
+  }
+  if (tables.record) {
+    lua_pushvalue(state, -1);
+    lua_rawseti(state, tables.list, ++tables.next);
+  }
+}
+
+void open_field(lua_State* state, int parent, const char* key, int narray, int nrecord, Tables& tables) {
+  if (tables.list != 0 && !tables.record) {
+    lua_rawgeti(state, tables.list, ++tables.next);
     return;
   }
-  lua_pop(state, 1);
-  lua_createtable(state, narray, nrecord);   // key table
-  lua_pushvalue(state, -2);
-  lua_pushvalue(state, -2);
-  lua_rawset(state, parent);
-  lua_remove(state, -2);
-}
-
-void open_field(lua_State* state, int parent, const char* key, int narray, int nrecord) {
   lua_pushstring(state, key);
-  open(state, parent, narray, nrecord);
+  open(state, parent, narray, nrecord, tables);
 }
 
-void open_index(lua_State* state, int parent, lua_Integer i, int narray, int nrecord) {
+void open_index(lua_State* state, int parent, lua_Integer i, int narray, int nrecord, Tables& tables) {
+  if (tables.list != 0 && !tables.record) {
+    lua_rawgeti(state, tables.list, ++tables.next);
+    return;
+  }
   lua_pushinteger(state, i);
-  open(state, parent, narray, nrecord);
+  open(state, parent, narray, nrecord, tables);
 }
 
 void set_number(lua_State* state, int table, const char* key, double value) {
@@ -271,8 +291,9 @@ void set_number(lua_State* state, int table, const char* key, double value) {
   lua_rawset(state, table);
 }
 
-void write_numbers(lua_State* state, int parent, const char* key, const double* values, int n) {
-  open_field(state, parent, key, n, 0);
+void write_numbers(lua_State* state, int parent, const char* key, const double* values, int n,
+                   Tables& tables) {
+  open_field(state, parent, key, n, 0, tables);
   for (int i = 0; i < n; ++i) {
     lua_pushnumber(state, values[i]);
     lua_rawseti(state, -2, i + 1);
@@ -280,9 +301,9 @@ void write_numbers(lua_State* state, int parent, const char* key, const double* 
   lua_pop(state, 1);
 }
 
-void write_vec3(lua_State* state, int parent, const char* key, const Vec3& v) {
+void write_vec3(lua_State* state, int parent, const char* key, const Vec3& v, Tables& tables) {
   const double values[3] = {v.x(), v.y(), v.z()};
-  write_numbers(state, parent, key, values, 3);
+  write_numbers(state, parent, key, values, 3, tables);
 }
 
 const char* phase_name(ContactPhase phase) {
@@ -295,21 +316,21 @@ const char* phase_name(ContactPhase phase) {
 }
 
 // Writes snapshot `s` into the table at absolute index `table`.
-void write_state(lua_State* state, int table, const Snapshot& s) {
+void write_state(lua_State* state, int table, const Snapshot& s, Tables& tables) {
   set_number(state, table, "time", s.time);
-  open_field(state, table, "objects", 0, static_cast<int>(s.objects.size()));
+  open_field(state, table, "objects", 0, static_cast<int>(s.objects.size()), tables);
   const int objects = lua_gettop(state);
   for (const ObjectSnapshot& o : s.objects) {
-    open_field(state, objects, o.name.c_str(), 0, 7);
+    open_field(state, objects, o.name.c_str(), 0, 7, tables);
     const int t = lua_gettop(state);
-    write_vec3(state, t, "position", o.position);
+    write_vec3(state, t, "position", o.position, tables);
     const double q[4] = {o.orientation.w(), o.orientation.x(), o.orientation.y(), o.orientation.z()};
-    write_numbers(state, t, "orientation", q, 4);
-    open_field(state, t, "rotation", 3, 0);
+    write_numbers(state, t, "orientation", q, 4, tables);
+    open_field(state, t, "rotation", 3, 0, tables);
     const int rows = lua_gettop(state);
     const Mat3 r = o.orientation.toRotationMatrix();
     for (int i = 0; i < 3; ++i) {
-      open_index(state, rows, i + 1, 3, 0);
+      open_index(state, rows, i + 1, 3, 0, tables);
       for (int j = 0; j < 3; ++j) {
         lua_pushnumber(state, r(i, j));
         lua_rawseti(state, -2, j + 1);
@@ -317,22 +338,22 @@ void write_state(lua_State* state, int table, const Snapshot& s) {
       lua_pop(state, 1);
     }
     lua_pop(state, 1);
-    write_vec3(state, t, "velocity", o.velocity);
-    write_vec3(state, t, "angular_velocity", o.angular_velocity);
+    write_vec3(state, t, "velocity", o.velocity, tables);
+    write_vec3(state, t, "angular_velocity", o.angular_velocity, tables);
     lua_pushliteral(state, "floor_contacts");
     lua_pushinteger(state, o.floor_contacts);
     lua_rawset(state, t);
     lua_pop(state, 1);
   }
   lua_pop(state, 1);
-  open_field(state, table, "fingers", 0, static_cast<int>(s.fingers.size()));
+  open_field(state, table, "fingers", 0, static_cast<int>(s.fingers.size()), tables);
   const int fingers = lua_gettop(state);
   for (const FingerSnapshot& f : s.fingers) {
-    open_field(state, fingers, f.name.c_str(), 0, 7);
+    open_field(state, fingers, f.name.c_str(), 0, 7, tables);
     const int t = lua_gettop(state);
-    write_vec3(state, t, "hip", f.hip);
-    write_vec3(state, t, "god_object", f.god_object);
-    write_vec3(state, t, "force", f.force);
+    write_vec3(state, t, "hip", f.hip, tables);
+    write_vec3(state, t, "god_object", f.god_object, tables);
+    write_vec3(state, t, "force", f.force, tables);
     lua_pushliteral(state, "touching");
     lua_pushlstring(state, f.touching.data(), f.touching.size());
     lua_rawset(state, t);
@@ -345,9 +366,9 @@ void write_state(lua_State* state, int table, const Snapshot& s) {
   lua_pop(state, 1);
 }
 
-void push_state(lua_State* state, const Snapshot& s) {
+void push_state(lua_State* state, const Snapshot& s, Tables& tables) {
   lua_createtable(state, 0, 4);
-  write_state(state, lua_gettop(state), s);
+  write_state(state, lua_gettop(state), s, tables);
 }
 
 struct SimArguments {
@@ -357,8 +378,9 @@ struct SimArguments {
 
 int push_sim_protected(lua_State* state) {
   const SimArguments& sim = *static_cast<const SimArguments*>(lua_touserdata(state, 1));
-  push_state(state, *sim.now);
-  push_state(state, *sim.initial);
+  Tables by_key;
+  push_state(state, *sim.now, by_key);
+  push_state(state, *sim.initial, by_key);
   lua_setfield(state, -2, "initial");
   return 1;
 }
@@ -368,8 +390,10 @@ int push_sim_protected(lua_State* state) {
 // reads through to it (__index = the table, __len, __pairs) and refuses writes (__newindex), with
 // a protected metatable. A userdata, not an empty table, so that rawset cannot shadow a field.
 
-// The registry key of the view (its root proxy): the address of this variable.
+// The registry keys of the view (its root proxy) and of the list of its data tables in the order
+// write_state() opens them: the addresses of these variables.
 const char kViewKey = 0;
+const char kViewTablesKey = 0;
 
 int view_newindex(lua_State* state) {
   const char* key = lua_type(state, 2) == LUA_TSTRING ? lua_tostring(state, 2) : nullptr;
@@ -441,16 +465,29 @@ void seal(lua_State* state) {
 
 int update_view_protected(lua_State* state) {
   const Snapshot& now = *static_cast<const Snapshot*>(lua_touserdata(state, 1));
-  if (lua_rawgetp(state, LUA_REGISTRYINDEX, &kViewKey) == LUA_TUSERDATA) {
+  // The tables write_state() opens: objects, 9 per object (itself, position, orientation,
+  // rotation and its 3 rows, velocity, angular_velocity), fingers, 4 per finger (itself, hip,
+  // god_object, force). A snapshot of another shape than the first builds the view anew.
+  const lua_Unsigned tables = 2 + 9 * now.objects.size() + 4 * now.fingers.size();
+  lua_rawgetp(state, LUA_REGISTRYINDEX, &kViewTablesKey);
+  const bool same_shape = lua_type(state, -1) == LUA_TTABLE && lua_rawlen(state, -1) == tables;
+  lua_pop(state, 1);
+  if (same_shape && lua_rawgetp(state, LUA_REGISTRYINDEX, &kViewKey) == LUA_TUSERDATA) {
     lua_getmetatable(state, -1);
     lua_pushliteral(state, "__index");
-    lua_rawget(state, -2);
-    write_state(state, lua_gettop(state), now);
+    lua_rawget(state, -2);                                   // proxy mt data
+    lua_rawgetp(state, LUA_REGISTRYINDEX, &kViewTablesKey);  // proxy mt data list
+    Tables from_list{lua_gettop(state), false, 0};
+    write_state(state, lua_gettop(state) - 1, now, from_list);
     return 0;
   }
-  lua_pop(state, 1);
-  push_state(state, now);
-  seal(state);
+  lua_settop(state, 1);
+  lua_newtable(state);                                       // list
+  lua_pushvalue(state, -1);
+  lua_rawsetp(state, LUA_REGISTRYINDEX, &kViewTablesKey);
+  Tables record{lua_gettop(state), true, 0};
+  push_state(state, now, record);                            // list data
+  seal(state);                                               // list proxy
   lua_rawsetp(state, LUA_REGISTRYINDEX, &kViewKey);
   return 0;
 }
