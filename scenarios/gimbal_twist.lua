@@ -66,7 +66,7 @@ return {
       at = 1.75,
       check = function(sim)
         local a, want = about_x(sim.objects.box), math.deg(pitch) / 2
-        local allowance = 1.875 * math.deg(pitch) / 1.5 * 0.02
+        local allowance = 1.875 * math.abs(math.deg(pitch)) / 1.5 * 0.02
         return math.abs(a - want) < allowance,
                string.format("%.3f degrees for a pitch of %.1f (allowance %.2f)", a, want, allowance)
       end },

@@ -117,3 +117,21 @@ TEST_CASE("without its controller the pole falls", "[e2e][feedback][scenario]") 
   INFO(result.error);
   CHECK(upright_failed);
 }
+
+// Scripted pitch reaches the engine's input: in gimbal_twist the thumb's waypoint pitch goes
+// from 0 to the `pitch` parameter, and the engine turns the box by each physics step's pitch
+// change (section 3.2, solution 1), which the trace records as `twist`. So the twists over the
+// run sum to the whole pitch change, here -45 degrees (the sign too), up to the rounding of the
+// ~150 steps' differences (1e-12 rad); and the scenario's own expectations hold.
+TEST_CASE("a scripted gimbal pitch turns the box by the pitch change end to end", "[e2e][gimbal]") {
+  const app::RunResult result = run(kScenarios + "gimbal_twist.lua", {"pitch=-45"}, "gimbal_pitch");
+  REQUIRE(result.error.empty());
+  for (const auto& e : result.expectations) {
+    INFO(e.what << ": " << e.detail);
+    CHECK(e.passed);
+  }
+  const auto twist = recordings::read_dataset(kTmp + "/gimbal_pitch.h5", "/physics/objects/box/twist").values;
+  double sum = 0.0;
+  for (double x : twist) sum += x;
+  CHECK(sum == Approx(-M_PI / 4).margin(1e-12));
+}
