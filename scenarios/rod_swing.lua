@@ -3,20 +3,23 @@
 -- fingers at one end and swung, the position of the centre of gravity of the rod will follow an
 -- arc, (as long as there is no slip at the grasp points)").
 --
--- A 30 cm, 0.2 kg rod (3 x 3 cm) hangs from thumb and index pinching it 3 cm below its top end,
--- 1 cm deep each side (4 N per finger, mu = 1). Two point contacts hold no torque about the line
--- through them (section 3.2; no torsion rule here), so the grip is a hinge and the rod a pendulum
--- hung from the hand: centre of mass d = 12 cm below the grip, small swings at
--- w = sqrt(m g d / (J_c + m d^2)) = 7.1 rad/s. The hand swings it by moving 1.5 cm back and forth
--- along x at w from 0.3 s to about 2.3 s, then holds still while the rod swings on.
--- Nothing slips: each finger carries half the rod's pull along it, at most m g (3 - 2 cos a) / 2
--- = 1.5 N for swings up to a = 40 degrees, while its friction circle allows mu k d = 4 N.
+-- A 30 cm, 0.5 kg rod (4 x 4 cm) hangs from thumb and index pinching it 3 cm below its top end,
+-- 1.5 cm deep each side (k = 300 N/m: 4.5 N per finger, mu = 1). Two point contacts hold no
+-- torque about the line through them (section 3.2; no torsion rule here), so the grip is a hinge
+-- and the rod a pendulum hung from the hand: centre of mass r = 12 cm below the grip, J about
+-- the grip 0.011 kg m^2, small swings at w = sqrt(m g r / J) = 7.3 rad/s. The hand swings it by
+-- moving 1.5 cm back and forth along x at w from 0.3 s to about 2.3 s, then holds still while
+-- the rod swings on. At the paper's 50 Hz physics the grip is stable: the mode of the rod on the
+-- finger springs (m_eff = 0.17 kg at the grip, 2 k = 600 N/m) turns 1.2 rad per step, under 2.
+-- Nothing slips: the fingers share the rod's pull along it, at most (at the bottom of a swing
+-- of a = 35 degrees) m g (1 + (1 - cos a)(2 m r^2 / J)) = 6.4 N, 3.2 N each, while each
+-- friction circle allows mu k d = 4.5 N.
 -- So the centre of mass stays at a fixed distance from the hand but for the finger springs,
 -- which stretch with the pull along the rod, T / (2 k); for a rod swinging to a about a pivot
 -- (J about the grip, r grip to centre) T = m (g cos phi + r phi'^2) changes between the bottom
 -- and the turning points by m g (1 - cos a)(1 + 2 m r^2 / J). It pulls at twice the swing's
 -- frequency on the springs' own mode along the rod (sqrt(2 k / m) = 35 rad/s), which amplifies
--- it by 1 / (1 - (2 w)^2 m / (2 k)) = 1.19. The check: while the hand holds still, the distance
+-- it by 1 / (1 - (2 w)^2 m / (2 k)) = 1.22. The check: while the hand holds still, the distance
 -- from the hand to the centre of mass, sampled at every physics tick through the trajectory's
 -- view, stays within a band of that change / (2 k) (r taken as the band's middle, since the
 -- fingers catch the falling rod a few mm higher up than aimed), plus 10 % for what the bound
