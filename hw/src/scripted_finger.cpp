@@ -11,8 +11,10 @@ ScriptedFinger::ScriptedFinger(std::unique_ptr<Trajectory> trajectory, DeviceLim
 }
 
 DeviceSample ScriptedFinger::read(std::int64_t /*tick*/, double time) {
+  const TrajectorySample t = trajectory_->sample(time);
   DeviceSample s;
-  s.position = trajectory_->position(time);
+  s.position = t.position;
+  s.gimbal = t.gimbal;
   return s;
 }
 

@@ -226,55 +226,149 @@ int param_type_error(lua_State* state, const Override& chosen, const char* name,
                     name, expected);
 }
 
-void push_vec3(lua_State* state, const Vec3& v) {
-  lua_createtable(state, 3, 0);
-  for (int i = 0; i < 3; ++i) {
-    lua_pushnumber(state, v[i]);
-    lua_rawseti(state, -2, i + 1);
+// Tables of the `sim` shape are written in place: write_state() reuses the tables it finds
+// (numbers overwritten, nothing allocated after the first time) and creates the missing ones, so
+// one function fills both a fresh `sim` for a check and the persistent view trajectories read.
+// In the view every table is behind a read-only proxy (below); open() looks through it.
+
+// Where write_state() finds the tables it writes into: by key (looking through read-only
+// proxies; a check's fresh `sim`, and the view's first update, which also lists every table it
+// opens, in order, in the table at `list`), or, for the view's later updates, from that list in
+// the same order: one lua_rawgeti per table instead of a key lookup and a proxy.
+struct Tables {
+  int list = 0;         // absolute stack index of the list of tables, or 0
+  bool record = false;  // true: open by key and append to the list; false: take from the list
+  lua_Integer next = 0; // tables taken or appended so far
+};
+
+// The table under the key at the top of the stack in the table at absolute index `parent`:
+// replaces the key with it (the data behind a read-only proxy), creating it if absent.
+void open(lua_State* state, int parent, int narray, int nrecord, Tables& tables) {
+  lua_pushvalue(state, -1);
+  lua_rawget(state, parent);   // key value
+  if (lua_type(state, -1) == LUA_TTABLE) {
+    lua_remove(state, -2);
+  } else if (lua_type(state, -1) == LUA_TUSERDATA && lua_getmetatable(state, -1)) {   // key proxy mt
+    lua_pushliteral(state, "__index");
+    lua_rawget(state, -2);     // key proxy mt data
+    lua_replace(state, -4);
+    lua_pop(state, 2);
+  } else {
+    lua_pop(state, 1);
+    lua_createtable(state, narray, nrecord);   // key table
+    lua_pushvalue(state, -2);
+    lua_pushvalue(state, -2);
+    lua_rawset(state, parent);
+    lua_remove(state, -2);
+  }
+  if (tables.record) {
+    lua_pushvalue(state, -1);
+    lua_rawseti(state, tables.list, ++tables.next);
   }
 }
 
-void push_state(lua_State* state, const Snapshot& s) {
-  lua_createtable(state, 0, 4);
-  lua_pushnumber(state, s.time);
-  lua_setfield(state, -2, "time");
-  lua_createtable(state, 0, static_cast<int>(s.objects.size()));
+void open_field(lua_State* state, int parent, const char* key, int narray, int nrecord, Tables& tables) {
+  if (tables.list != 0 && !tables.record) {
+    lua_rawgeti(state, tables.list, ++tables.next);
+    return;
+  }
+  lua_pushstring(state, key);
+  open(state, parent, narray, nrecord, tables);
+}
+
+void open_index(lua_State* state, int parent, lua_Integer i, int narray, int nrecord, Tables& tables) {
+  if (tables.list != 0 && !tables.record) {
+    lua_rawgeti(state, tables.list, ++tables.next);
+    return;
+  }
+  lua_pushinteger(state, i);
+  open(state, parent, narray, nrecord, tables);
+}
+
+void set_number(lua_State* state, int table, const char* key, double value) {
+  lua_pushstring(state, key);
+  lua_pushnumber(state, value);
+  lua_rawset(state, table);
+}
+
+void write_numbers(lua_State* state, int parent, const char* key, const double* values, int n,
+                   Tables& tables) {
+  open_field(state, parent, key, n, 0, tables);
+  for (int i = 0; i < n; ++i) {
+    lua_pushnumber(state, values[i]);
+    lua_rawseti(state, -2, i + 1);
+  }
+  lua_pop(state, 1);
+}
+
+void write_vec3(lua_State* state, int parent, const char* key, const Vec3& v, Tables& tables) {
+  const double values[3] = {v.x(), v.y(), v.z()};
+  write_numbers(state, parent, key, values, 3, tables);
+}
+
+const char* phase_name(ContactPhase phase) {
+  switch (phase) {
+    case ContactPhase::kStick: return "stick";
+    case ContactPhase::kSlip: return "slip";
+    case ContactPhase::kFree: break;
+  }
+  return "free";
+}
+
+// Writes snapshot `s` into the table at absolute index `table`.
+void write_state(lua_State* state, int table, const Snapshot& s, Tables& tables) {
+  set_number(state, table, "time", s.time);
+  open_field(state, table, "objects", 0, static_cast<int>(s.objects.size()), tables);
+  const int objects = lua_gettop(state);
   for (const ObjectSnapshot& o : s.objects) {
-    lua_createtable(state, 0, 5);
-    push_vec3(state, o.position);
-    lua_setfield(state, -2, "position");
-    lua_createtable(state, 4, 0);
+    open_field(state, objects, o.name.c_str(), 0, 7, tables);
+    const int t = lua_gettop(state);
+    write_vec3(state, t, "position", o.position, tables);
     const double q[4] = {o.orientation.w(), o.orientation.x(), o.orientation.y(), o.orientation.z()};
-    for (int i = 0; i < 4; ++i) {
-      lua_pushnumber(state, q[i]);
-      lua_rawseti(state, -2, i + 1);
+    write_numbers(state, t, "orientation", q, 4, tables);
+    open_field(state, t, "rotation", 3, 0, tables);
+    const int rows = lua_gettop(state);
+    const Mat3 r = o.orientation.toRotationMatrix();
+    for (int i = 0; i < 3; ++i) {
+      open_index(state, rows, i + 1, 3, 0, tables);
+      for (int j = 0; j < 3; ++j) {
+        lua_pushnumber(state, r(i, j));
+        lua_rawseti(state, -2, j + 1);
+      }
+      lua_pop(state, 1);
     }
-    lua_setfield(state, -2, "orientation");
-    push_vec3(state, o.velocity);
-    lua_setfield(state, -2, "velocity");
-    push_vec3(state, o.angular_velocity);
-    lua_setfield(state, -2, "angular_velocity");
+    lua_pop(state, 1);
+    write_vec3(state, t, "velocity", o.velocity, tables);
+    write_vec3(state, t, "angular_velocity", o.angular_velocity, tables);
+    lua_pushliteral(state, "floor_contacts");
     lua_pushinteger(state, o.floor_contacts);
-    lua_setfield(state, -2, "floor_contacts");
-    lua_setfield(state, -2, o.name.c_str());
+    lua_rawset(state, t);
+    lua_pop(state, 1);
   }
-  lua_setfield(state, -2, "objects");
-  lua_createtable(state, 0, static_cast<int>(s.fingers.size()));
+  lua_pop(state, 1);
+  open_field(state, table, "fingers", 0, static_cast<int>(s.fingers.size()), tables);
+  const int fingers = lua_gettop(state);
   for (const FingerSnapshot& f : s.fingers) {
-    lua_createtable(state, 0, 5);
-    push_vec3(state, f.hip);
-    lua_setfield(state, -2, "hip");
-    push_vec3(state, f.god_object);
-    lua_setfield(state, -2, "god_object");
-    push_vec3(state, f.force);
-    lua_setfield(state, -2, "force");
+    open_field(state, fingers, f.name.c_str(), 0, 7, tables);
+    const int t = lua_gettop(state);
+    write_vec3(state, t, "hip", f.hip, tables);
+    write_vec3(state, t, "god_object", f.god_object, tables);
+    write_vec3(state, t, "force", f.force, tables);
+    lua_pushliteral(state, "touching");
     lua_pushlstring(state, f.touching.data(), f.touching.size());
-    lua_setfield(state, -2, "touching");
-    lua_pushnumber(state, f.slip);
-    lua_setfield(state, -2, "slip");
-    lua_setfield(state, -2, f.name.c_str());
+    lua_rawset(state, t);
+    lua_pushliteral(state, "phase");
+    lua_pushstring(state, phase_name(f.phase));
+    lua_rawset(state, t);
+    set_number(state, t, "slip", f.slip);
+    lua_pop(state, 1);
   }
-  lua_setfield(state, -2, "fingers");
+  lua_pop(state, 1);
+}
+
+void push_state(lua_State* state, const Snapshot& s, Tables& tables) {
+  lua_createtable(state, 0, 4);
+  write_state(state, lua_gettop(state), s, tables);
 }
 
 struct SimArguments {
@@ -284,10 +378,118 @@ struct SimArguments {
 
 int push_sim_protected(lua_State* state) {
   const SimArguments& sim = *static_cast<const SimArguments*>(lua_touserdata(state, 1));
-  push_state(state, *sim.now);
-  push_state(state, *sim.initial);
+  Tables by_key;
+  push_state(state, *sim.now, by_key);
+  push_state(state, *sim.initial, by_key);
   lua_setfield(state, -2, "initial");
   return 1;
+}
+
+// ---------------------------------------------------------------------------------------------
+// The read-only view: every table of the `sim` shape sits behind a full userdata whose metatable
+// reads through to it (__index = the table, __len, __pairs) and refuses writes (__newindex), with
+// a protected metatable. A userdata, not an empty table, so that rawset cannot shadow a field.
+
+// The registry keys of the view (its root proxy) and of the list of its data tables in the order
+// write_state() opens them: the addresses of these variables.
+const char kViewKey = 0;
+const char kViewTablesKey = 0;
+
+int view_newindex(lua_State* state) {
+  const char* key = lua_type(state, 2) == LUA_TSTRING ? lua_tostring(state, 2) : nullptr;
+  if (key != nullptr) {
+    return luaL_error(state, "the simulation view is read-only (cannot set field '%s')", key);
+  }
+  return luaL_error(state, "the simulation view is read-only (cannot set an element)");
+}
+
+// The data table behind the proxy at index 1.
+void view_data(lua_State* state) {
+  lua_getmetatable(state, 1);
+  lua_pushliteral(state, "__index");
+  lua_rawget(state, -2);
+}
+
+int view_len(lua_State* state) {
+  view_data(state);
+  lua_pushinteger(state, static_cast<lua_Integer>(lua_rawlen(state, -1)));
+  return 1;
+}
+
+int view_next(lua_State* state) {   // next over a proxy's data, values as the proxy gives them
+  lua_settop(state, 2);
+  view_data(state);                  // proxy key mt data
+  lua_pushvalue(state, 2);
+  if (lua_next(state, 4) == 0) return 0;
+  return 2;
+}
+
+int view_pairs(lua_State* state) {
+  lua_pushcfunction(state, view_next);
+  lua_pushvalue(state, 1);
+  lua_pushnil(state);
+  return 3;
+}
+
+// Replaces every table reachable from the table at the top of the stack, and that table itself,
+// by a read-only proxy.
+void seal(lua_State* state) {
+  luaL_checkstack(state, 8, "sealing the simulation view");
+  const int data = lua_gettop(state);
+  lua_pushnil(state);
+  while (lua_next(state, data) != 0) {   // key value
+    if (lua_type(state, -1) == LUA_TTABLE) {
+      seal(state);                       // key proxy
+      lua_pushvalue(state, -2);
+      lua_insert(state, -2);             // key key proxy
+      lua_rawset(state, data);           // an existing key: allowed while traversing
+    } else {
+      lua_pop(state, 1);
+    }
+  }
+  lua_newuserdatauv(state, 0, 0);        // data proxy
+  lua_createtable(state, 0, 5);          // data proxy mt
+  lua_pushvalue(state, data);
+  lua_setfield(state, -2, "__index");
+  lua_pushcfunction(state, view_newindex);
+  lua_setfield(state, -2, "__newindex");
+  lua_pushcfunction(state, view_len);
+  lua_setfield(state, -2, "__len");
+  lua_pushcfunction(state, view_pairs);
+  lua_setfield(state, -2, "__pairs");
+  lua_pushliteral(state, "read-only");
+  lua_setfield(state, -2, "__metatable");
+  lua_setmetatable(state, -2);           // data proxy
+  lua_replace(state, data);              // proxy
+}
+
+int update_view_protected(lua_State* state) {
+  const Snapshot& now = *static_cast<const Snapshot*>(lua_touserdata(state, 1));
+  // The tables write_state() opens: objects, 9 per object (itself, position, orientation,
+  // rotation and its 3 rows, velocity, angular_velocity), fingers, 4 per finger (itself, hip,
+  // god_object, force). A snapshot of another shape than the first builds the view anew.
+  const lua_Unsigned tables = 2 + 9 * now.objects.size() + 4 * now.fingers.size();
+  lua_rawgetp(state, LUA_REGISTRYINDEX, &kViewTablesKey);
+  const bool same_shape = lua_type(state, -1) == LUA_TTABLE && lua_rawlen(state, -1) == tables;
+  lua_pop(state, 1);
+  if (same_shape && lua_rawgetp(state, LUA_REGISTRYINDEX, &kViewKey) == LUA_TUSERDATA) {
+    lua_getmetatable(state, -1);
+    lua_pushliteral(state, "__index");
+    lua_rawget(state, -2);                                   // proxy mt data
+    lua_rawgetp(state, LUA_REGISTRYINDEX, &kViewTablesKey);  // proxy mt data list
+    Tables from_list{lua_gettop(state), false, 0};
+    write_state(state, lua_gettop(state) - 1, now, from_list);
+    return 0;
+  }
+  lua_settop(state, 1);
+  lua_newtable(state);                                       // list
+  lua_pushvalue(state, -1);
+  lua_rawsetp(state, LUA_REGISTRYINDEX, &kViewTablesKey);
+  Tables record{lua_gettop(state), true, 0};
+  push_state(state, now, record);                            // list data
+  seal(state);                                               // list proxy
+  lua_rawsetp(state, LUA_REGISTRYINDEX, &kViewKey);
+  return 0;
 }
 
 std::string lua_number_text(lua_State* state, int index) {
@@ -393,34 +595,46 @@ void push_sim(LuaSandbox& sandbox, const Snapshot& now, const Snapshot& initial)
   sandbox.protect(push_sim_protected, &sim, 0, 1);
 }
 
-bool read_position(lua_State* state, int first, Vec3& position, std::string& found) {
+void update_view(LuaSandbox& sandbox, const Snapshot& now) {
+  sandbox.protect(update_view_protected, const_cast<Snapshot*>(&now), 0, 0);
+}
+
+void push_view(lua_State* state) {
+  lua_rawgetp(state, LUA_REGISTRYINDEX, &kViewKey);
+}
+
+bool read_position(lua_State* state, int first, Vec3& position, double& pitch, std::string& found) {
+  pitch = 0.0;
   if (lua_type(state, first) == LUA_TTABLE) {
     const lua_Unsigned length = lua_rawlen(state, first);
     if (!lua_checkstack(state, 1)) {
       found = "(Lua stack overflow)";
       return false;
     }
-    bool ok = length == 3;
-    for (int i = 0; ok && i < 3; ++i) {
-      lua_rawgeti(state, first, i + 1);
+    bool ok = length == 3 || length == 4;
+    for (lua_Unsigned i = 0; ok && i < length; ++i) {
+      lua_rawgeti(state, first, static_cast<lua_Integer>(i) + 1);
       ok = lua_type(state, -1) == LUA_TNUMBER;
-      if (ok) position[i] = lua_tonumber(state, -1);
+      if (ok) (i < 3 ? position[static_cast<int>(i)] : pitch) = lua_tonumber(state, -1);
       lua_pop(state, 1);
     }
-    if (!ok) found = "a table that is not {x, y, z} (" + std::to_string(length) + " elements)";
+    if (!ok) found = "a table that is not {x, y, z} or {x, y, z, pitch} (" + std::to_string(length) + " elements)";
     return ok;
   }
-  for (int i = 0; i < 3; ++i) {
-    if (lua_type(state, first + i) != LUA_TNUMBER) {
-      found.clear();
-      for (int j = 0; j < 3; ++j) {
-        found += (j == 0 ? "" : ", ") + std::string(luaL_typename(state, first + j));
-      }
-      found = "(" + found + ")";
-      return false;
+  const int pitch_type = lua_type(state, first + 3);
+  bool ok = pitch_type == LUA_TNUMBER || pitch_type == LUA_TNIL || pitch_type == LUA_TNONE;
+  for (int i = 0; i < 3; ++i) ok = ok && lua_type(state, first + i) == LUA_TNUMBER;
+  if (!ok) {
+    found.clear();
+    for (int j = 0; j < 4; ++j) {
+      if (j == 3 && lua_isnoneornil(state, first + 3)) break;
+      found += (j == 0 ? "" : ", ") + std::string(luaL_typename(state, first + j));
     }
-    position[i] = lua_tonumber(state, first + i);
+    found = "(" + found + ")";
+    return false;
   }
+  for (int i = 0; i < 3; ++i) position[i] = lua_tonumber(state, first + i);
+  if (pitch_type == LUA_TNUMBER) pitch = lua_tonumber(state, first + 3);
   return true;
 }
 

@@ -44,9 +44,17 @@ LuaValue read_params(lua_State* state);
 // Pushes sim = {time, objects = {<name> = {...}}, fingers = {<name> = {...}}, initial = {...}}.
 void push_sim(LuaSandbox& sandbox, const Snapshot& now, const Snapshot& initial);
 
-// The results of a trajectory function, from stack index `first` on: x, y, z or {x, y, z}.
-// Returns false (with `found` saying what was there) when they are not three numbers.
-bool read_position(lua_State* state, int first, Vec3& position, std::string& found);
+// The read-only view trajectory functions get as their second argument: the same shape as `sim`
+// (without `initial`), kept in the registry and written in place, so that after the first call
+// an update allocates nothing (the names are interned strings, the tables exist).
+void update_view(LuaSandbox& sandbox, const Snapshot& now);
+// Pushes the view (nil before the first update_view). Raw access: raises nothing.
+void push_view(lua_State* state);
+
+// The results of a trajectory function, from stack index `first` on: x, y, z[, pitch] or
+// {x, y, z[, pitch]} (pitch in rad, 0 when absent). Returns false (with `found` saying what was
+// there) when they are not three or four numbers.
+bool read_position(lua_State* state, int first, Vec3& position, double& pitch, std::string& found);
 
 // The results of a check function at `first` and first + 1: a boolean, then nil, a string or a
 // number. Returns false (with `found` naming the wrong type) when they are not.

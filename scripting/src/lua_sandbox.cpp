@@ -57,12 +57,20 @@ int print_to_stderr(lua_State* state) {
   return 0;
 }
 
-// Calls the wrapped library function (upvalue 1) with the wrapper's arguments, returning its results.
+// Calls the wrapped library function (upvalue 1) with the wrapper's arguments, returning its
+// results. Its errors get the caller's file:line: raised from a C function called by a C
+// function, they would carry no place.
 int call_wrapped(lua_State* state) {
   lua_pushvalue(state, lua_upvalueindex(1));
   lua_insert(state, 1);
-  lua_call(state, lua_gettop(state) - 1, LUA_MULTRET);
-  return lua_gettop(state);
+  const int status = lua_pcall(state, lua_gettop(state) - 1, LUA_MULTRET, 0);
+  if (status == LUA_OK) return lua_gettop(state);
+  if (status == LUA_ERRRUN && lua_type(state, -1) == LUA_TSTRING) {
+    luaL_where(state, 1);
+    lua_insert(state, -2);
+    lua_concat(state, 2);
+  }
+  return lua_error(state);
 }
 
 // math.randomseed without an argument would seed from the clock: refuse it.
@@ -78,6 +86,7 @@ int randomseed_checked(lua_State* state) {
 // could not stop an endless loop in one. (A __gc added to a metatable after setmetatable never
 // runs: Lua marks objects for finalization only here.)
 int setmetatable_checked(lua_State* state) {
+  luaL_checktype(state, 1, LUA_TTABLE);   // named 'setmetatable' in the message, not '?'
   if (lua_type(state, 2) == LUA_TTABLE) {
     lua_pushliteral(state, "__gc");
     const int type = lua_rawget(state, 2);

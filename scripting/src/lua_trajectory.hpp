@@ -1,4 +1,5 @@
-// A finger trajectory given as a Lua function of time, called at every servo tick.
+// A finger trajectory given as a Lua function of time (and of the read-only simulation view),
+// called at every servo tick.
 #pragma once
 
 #include <string>
@@ -13,10 +14,11 @@ class LuaTrajectory final : public hw::Trajectory {
   // `function_ref`: registry reference of the function in `sandbox`, which must outlive this.
   // `label` names the finger in messages: "fingers[1] 'thumb'".
   LuaTrajectory(LuaSandbox& sandbox, int function_ref, std::string path, std::string label);
-  // Calls the function with t under the per-call instruction budget; no C++ allocation unless
-  // it fails. Throws ScenarioError (file:line and traceback, or what was returned instead of a
-  // finite x, y, z).
-  hw::Vec3 position(double t) override;
+  // Calls the function with t and the view (nil before the runner's first update_view) under
+  // the per-call instruction budget; no C++ allocation unless it fails. Returns the position and
+  // the gimbal pitch (0 unless the function returns a fourth value). Throws ScenarioError
+  // (file:line and traceback, or what was returned instead of a finite x, y, z[, pitch]).
+  hw::TrajectorySample sample(double t) override;
 
  private:
   LuaSandbox* sandbox_;

@@ -63,6 +63,16 @@ std::string finger_label(std::size_t i, const std::string& name) {
   return "fingers[" + std::to_string(i + 1) + "] '" + name + "'";
 }
 
+// Whether the Lua function under registry reference `ref` declares a second parameter (or takes
+// `...`): then it may read the view. Raw access and lua_getinfo: raises nothing.
+bool takes_view(lua_State* state, int ref) {
+  if (!lua_checkstack(state, 1)) return true;
+  lua_rawgeti(state, LUA_REGISTRYINDEX, ref);
+  lua_Debug info;
+  if (lua_getinfo(state, ">u", &info) == 0) return true;   // pops the function
+  return info.nparams >= 2 || info.isvararg != 0;
+}
+
 }  // namespace
 
 Scenario::Scenario() = default;
@@ -126,6 +136,7 @@ Scenario Scenario::load(const std::string& path, const LoadOptions& options) {
     s.expectations_ = std::move(parts.expectations);
     for (detail::TrajectoryParts& t : parts.trajectories) {
       s.trajectories_.push_back(TrajectorySpec{std::move(t.waypoints), t.interpolation, t.function_ref});
+      if (t.function_ref != 0) s.uses_view_ = s.uses_view_ || takes_view(state, t.function_ref);
     }
     // Trajectory and expectation functions draw from the scenario's own seed.
     lua.seed_random(static_cast<std::int64_t>(s.seed_));
@@ -148,6 +159,14 @@ std::unique_ptr<hw::Trajectory> Scenario::make_trajectory(std::size_t finger) co
   }
   return std::make_unique<detail::LuaTrajectory>(*lua_, spec.function_ref, path_,
                                                  finger_label(finger, model_.fingers[finger].name));
+}
+
+void Scenario::update_view(const Snapshot& now) const {
+  try {
+    detail::update_view(*lua_, now);
+  } catch (const ScenarioError& e) {
+    throw ScenarioError(detail::with_context(e.what(), path_, "updating the simulation view"));
+  }
 }
 
 ExpectationResult Scenario::check(std::size_t expectation, const Snapshot& now,

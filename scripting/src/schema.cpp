@@ -391,11 +391,23 @@ FingerParts finger(const LuaValue& value, std::size_t index) {
   if (!trajectory.is_table()) fail(at_trajectory, "expected " + shape + ", got " + trajectory.type_name());
   const std::vector<const LuaValue*> waypoints = array(trajectory, at_trajectory, shape);
   if (waypoints.empty()) fail(at_trajectory, "needs at least one waypoint");
+  bool has_pitch = false;
   for (std::size_t i = 0; i < waypoints.size(); ++i) {
     const Record w(*waypoints[i], at_trajectory[i + 1], TableKind::kWaypoint);
     hw::Waypoint waypoint;
     waypoint.time = finite_number(w.required("t", "the time in s"), w.at("t"));
     waypoint.position = vec3(w.required("p", "the position {x, y, z} in m"), w.at("p"));
+    // The gimbal pitch (rad): on every waypoint or on none, so that no waypoint holds an
+    // unstated angle.
+    const LuaValue* pitch = w.get("pitch");
+    if (i == 0) has_pitch = pitch != nullptr;
+    if ((pitch != nullptr) != has_pitch) {
+      fail(pitch != nullptr ? w.at("pitch") : at_trajectory[i + 1],
+           std::string(has_pitch ? "has no pitch but the first waypoint has one"
+                                 : "has a pitch but the first waypoint has none") +
+               ": give pitch (rad) on every waypoint or on none");
+    }
+    if (pitch != nullptr) waypoint.pitch = finite_number(*pitch, w.at("pitch"));
     if (i > 0 && !(waypoint.time > out.trajectory.waypoints.back().time)) {
       fail(w.at("t"), format_short(waypoint.time) + " s does not come after the previous "
                       "waypoint's " + format_short(out.trajectory.waypoints.back().time) +
@@ -459,7 +471,7 @@ const std::vector<std::string>& fields_of(TableKind kind) {
       "position", "orientation", "velocity", "angular_velocity", "material"};
   static const std::vector<std::string> kFinger = {
       "name", "stiffness", "damping", "radius", "max_force", "trajectory", "interpolation"};
-  static const std::vector<std::string> kWaypoint = {"t", "p"};
+  static const std::vector<std::string> kWaypoint = {"t", "p", "pitch"};
   static const std::vector<std::string> kExpectation = {"what", "at", "check"};
   static const std::vector<std::string> kNone;
   switch (kind) {

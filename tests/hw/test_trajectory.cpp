@@ -325,3 +325,30 @@ TEST_CASE("ScriptedFinger::read returns the trajectory's position, zero gimbal a
 
   CHECK_THROWS_AS(ScriptedFinger(nullptr, DeviceLimits{10.0}), std::invalid_argument);
 }
+
+// Scripted gimbal pitch: waypoints carry a pitch that is interpolated with the same s(u) as the
+// position, held before the first and after the last waypoint, and a scripted finger reports it
+// as the gimbal's pitch (y), roll and yaw zero. Expected values: the waypoints' own pitches, and
+// s(1/2) = 1/2 (both profiles) at mid-segment, s(1/4) = 1/4 (linear) and 10/64 - 15/256 + 6/1024
+// = 0.103515625 (minimum jerk) at a quarter. Tolerance: two roundings of a pitch of 1 rad.
+TEST_CASE("waypoint pitch is interpolated like the position and reaches the gimbal sample",
+          "[hw][scripted_finger][gimbal]") {
+  const std::vector<Waypoint> path = {{0.0, Vec3(0, 0, 0), 0.2}, {1.0, Vec3(0, 0, 0), 1.0},
+                                      {2.0, Vec3(0.1, 0, 0), -0.6}};
+  const double eps = 4e-16;
+  for (Interpolation interp : {Interpolation::kLinear, Interpolation::kMinimumJerk}) {
+    ScriptedFinger finger(std::make_unique<WaypointTrajectory>(path, interp), DeviceLimits{10.0});
+    const double quarter = interp == Interpolation::kLinear ? 0.25 : 0.103515625;
+    for (const Waypoint& w : path) CHECK(finger.read(0, w.time).gimbal == Vec3(0, w.pitch, 0));
+    CHECK(finger.read(0, -1.0).gimbal.y() == 0.2);
+    CHECK(finger.read(0, 5.0).gimbal.y() == -0.6);
+    CHECK(finger.read(0, 0.5).gimbal.y() == Approx(0.6).margin(eps));
+    CHECK(finger.read(0, 1.25).gimbal.y() == Approx(1.0 - 1.6 * quarter).margin(eps));
+    const DeviceSample s = finger.read(0, 1.5);
+    CHECK(s.gimbal.x() == 0.0);
+    CHECK(s.gimbal.z() == 0.0);
+  }
+  // A non-finite pitch is refused like a non-finite position.
+  CHECK_THROWS_AS(WaypointTrajectory({{0.0, Vec3::Zero(), std::nan("")}}, Interpolation::kLinear),
+                  std::invalid_argument);
+}

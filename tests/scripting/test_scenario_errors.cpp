@@ -89,7 +89,7 @@ TEST_CASE("an unknown field is named with its place and the closest known name",
   const Broken waypoint = broken("unknown_waypoint_field", "{t = 1, p = {-0.03, 0, 0.02}}",
                                  "{t = 1, pos = {-0.03, 0, 0.02}}");
   CHECK(waypoint.message == waypoint.path +
-        ": fingers[1] 'thumb': trajectory[2]: unknown field 'pos' (known fields: t, p)");
+        ": fingers[1] 'thumb': trajectory[2]: unknown field 'pos' (known fields: t, p, pitch)");
   const Broken two = broken("two_unknown_fields", "max_force = 8", "zeta = 1, alpha = 2");
   CHECK(two.message == two.path + ": fingers[1] 'thumb': unknown field 'alpha' (known fields: "
         "name, stiffness, damping, radius, max_force, trajectory, interpolation); unknown field 'zeta' (known "

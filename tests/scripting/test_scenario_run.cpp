@@ -90,12 +90,13 @@ TEST_CASE("a trajectory function that returns no finite x, y, z is an error nami
   auto pinky = s.make_trajectory(3);
   CHECK(error_of([&] { pinky->position(0.5); }) ==
         path + ": fingers[4] 'pinky' trajectory at t = 0.5 s: the function must return x, y, z (m) "
-               "or {x, y, z}, but returned (string, number, number)");
+               "and optionally the gimbal pitch (rad), or {x, y, z[, pitch]}, but returned "
+               "(string, number, number)");
   CHECK(error_of([&] { pinky->position(1.5); }) ==
         path + ": fingers[4] 'pinky' trajectory at t = 1.5 s: the function returned a non-finite "
                "position (nan, 0, 0)");
   CHECK_THAT(error_of([&] { pinky->position(2.5); }),
-             Contains("but returned a table that is not {x, y, z} (2 elements)"));
+             Contains("but returned a table that is not {x, y, z} or {x, y, z, pitch} (2 elements)"));
 }
 
 TEST_CASE("an endless loop in a trajectory function stops with the per-call budget message",
@@ -141,4 +142,88 @@ TEST_CASE("a check that does not return a boolean, or fails, is an error naming 
   CHECK_THAT(error_of([&] { s.check(3, now, now); }),
              StartsWith(path + ":" + std::to_string(line) + ": attempt to index a nil value") &&
              Contains("(expect[4] 'reads a missing object')\nstack traceback:"));
+}
+
+// Scripted gimbal pitch from a function: a fourth result (or a fourth element) is the pitch, 0
+// when absent; anything but a finite number there is an error naming the finger and the time.
+TEST_CASE("a trajectory function may return the gimbal pitch as a fourth value",
+          "[scenario][trajectory][gimbal]") {
+  const std::string path = scripting_test::write_scenario("pitch_function.lua", R"(return {
+  duration = 1,
+  fingers = {
+    { name = "a", trajectory = function(t) return 0, 0, 0, 2 * t end },
+    { name = "b", trajectory = function(t) return {1, 2, 3, -t} end },
+    { name = "c", trajectory = function(t) return 1, 2, 3 end },
+    { name = "d", trajectory = function(t) if t < 0.5 then return 0, 0, 0, "up" end return 0, 0, 0, 0 / 0 end },
+  } })");
+  const Scenario s = Scenario::load(path);
+  CHECK(s.make_trajectory(0)->sample(0.25).gimbal == Vec3(0, 0.5, 0));
+  const auto b = s.make_trajectory(1)->sample(0.5);
+  CHECK(b.position == Vec3(1, 2, 3));
+  CHECK(b.gimbal == Vec3(0, -0.5, 0));
+  CHECK(s.make_trajectory(2)->sample(0.5).gimbal == Vec3::Zero());
+  auto d = s.make_trajectory(3);
+  CHECK(error_of([&] { d->sample(0.25); }) ==
+        path + ": fingers[4] 'd' trajectory at t = 0.25 s: the function must return x, y, z (m) "
+               "and optionally the gimbal pitch (rad), or {x, y, z[, pitch]}, but returned "
+               "(number, number, number, string)");
+  CHECK(error_of([&] { d->sample(0.75); }) ==
+        path + ": fingers[4] 'd' trajectory at t = 0.75 s: the function returned a non-finite pitch (nan)");
+  // None of these functions takes the view, so the runner need not keep it.
+  CHECK_FALSE(s.uses_view());
+}
+
+// Waypoint pitch: on every waypoint or on none; a number.
+TEST_CASE("waypoints carry a pitch on all or none of them", "[scenario][trajectory][gimbal]") {
+  const auto scenario = [](const std::string& name, const std::string& waypoints) {
+    return scripting_test::write_scenario(name, "return { duration = 1, fingers = { { name = 'thumb', trajectory = " +
+                                                    waypoints + " } } }");
+  };
+  const std::string good = scenario("pitch_good.lua", "{ {t = 0, p = {0, 0, 0}, pitch = 0}, {t = 1, p = {0, 0, 0}, pitch = 1} }");
+  const Scenario s = Scenario::load(good);
+  CHECK(s.make_trajectory(0)->sample(0.5).gimbal.y() == Approx(0.5).margin(1e-15));   // s(1/2) = 1/2
+  CHECK(s.make_trajectory(0)->sample(2.0).gimbal.y() == 1.0);
+
+  const std::string missing = scenario("pitch_missing.lua", "{ {t = 0, p = {0, 0, 0}, pitch = 0}, {t = 1, p = {0, 0, 0}} }");
+  CHECK(scripting_test::load_error(missing) ==
+        missing + ": fingers[1] 'thumb': trajectory[2]: has no pitch but the first waypoint has one: "
+                  "give pitch (rad) on every waypoint or on none");
+  const std::string extra = scenario("pitch_extra.lua", "{ {t = 0, p = {0, 0, 0}}, {t = 1, p = {0, 0, 0}, pitch = 1} }");
+  CHECK(scripting_test::load_error(extra) ==
+        extra + ": fingers[1] 'thumb': trajectory[2].pitch: has a pitch but the first waypoint has none: "
+                "give pitch (rad) on every waypoint or on none");
+  const std::string text = scenario("pitch_text.lua", "{ {t = 0, p = {0, 0, 0}, pitch = 'up'} }");
+  CHECK_THAT(scripting_test::load_error(text), StartsWith(text + ": fingers[1] 'thumb': trajectory[1].pitch: "));
+}
+
+// The view: a function with a second parameter (or ...) makes the scenario keep it; it is nil
+// until the runner's first update_view, then the snapshot's values, read-only, the same shape as
+// a check's `sim` (time, objects with position, orientation, rotation rows, velocity,
+// angular_velocity, floor_contacts; fingers with hip, god_object, force, touching, phase, slip).
+TEST_CASE("a trajectory function reads the view it is given", "[scenario][trajectory][feedback]") {
+  const std::string path = scripting_test::write_scenario("view_read.lua", R"(return {
+  duration = 1,
+  objects = { { name = "box", size = {0.08, 0.08, 0.08}, mass = 0.4 } },
+  fingers = {
+    { name = "thumb", trajectory = function(t, sim)
+        if sim == nil then return -1, -1, -1 end
+        local b, f = sim.objects.box, sim.fingers.thumb
+        local n = 0
+        for _ in pairs(sim.objects) do n = n + 1 end
+        return b.position[3] + sim.time, #b.rotation + b.rotation[3][3] + n,
+               f.force[1] + (f.phase == "stick" and 100 or 0) + (f.touching == "box" and 1000 or 0)
+      end },
+  } })");
+  const Scenario s = Scenario::load(path);
+  CHECK(s.uses_view());
+  auto thumb = s.make_trajectory(0);
+  CHECK(thumb->position(0.0) == Vec3(-1, -1, -1));
+  Snapshot now = snapshot(0.25, 0.5);
+  now.fingers[0].phase = graspsim::ContactPhase::kStick;
+  s.update_view(now);
+  CHECK(thumb->position(0.3) == Vec3(0.75, 3 + 1 + 1, 2 + 100 + 1000));
+  now.objects[0].position.z() = 0.125;   // updated in place: the same tables, new numbers
+  now.time = 0.5;
+  s.update_view(now);
+  CHECK(thumb->position(0.6) == Vec3(0.625, 5, 1102));
 }

@@ -32,34 +32,42 @@ std::string body_name(const Model& model, int body) {
   return body == kFloor ? "floor" : "";
 }
 
-// What the scenario's expectation functions see.
-scripting::Snapshot snapshot(const Simulation& sim, const TickRecord& last,
-                             const std::vector<double>& slip) {
+// What the scenario's expectation functions and the trajectories' view see, written into `s`
+// in place: after the first call, for the same model, it allocates nothing (names are assigned
+// over equal names, vectors keep their size).
+void fill_snapshot(const Simulation& sim, const TickRecord& last, const std::vector<double>& slip,
+                   scripting::Snapshot& s) {
   const Model& model = sim.model();
   const State& state = sim.state();
-  scripting::Snapshot s;
   s.time = sim.time();
+  s.objects.resize(model.bodies.size());
   for (std::size_t b = 0; b < model.bodies.size(); ++b) {
     const BodyState& bs = state.bodies[b];
-    scripting::ObjectSnapshot o;
+    scripting::ObjectSnapshot& o = s.objects[b];
     o.name = model.bodies[b].name;
     o.position = bs.position;
     o.orientation = quat_of(bs.rotation);
     o.velocity = bs.velocity;
     o.angular_velocity = bs.angular_velocity;
     o.floor_contacts = last.physics[b].floor_contacts;
-    s.objects.push_back(std::move(o));
   }
+  s.fingers.resize(model.fingers.size());
   for (std::size_t f = 0; f < model.fingers.size(); ++f) {
-    scripting::FingerSnapshot fs;
+    scripting::FingerSnapshot& fs = s.fingers[f];
     fs.name = model.fingers[f].name;
     fs.hip = last.servo[f].hip;
     fs.force = last.servo[f].force;
     fs.god_object = last.haptic[f].god_object;
     fs.touching = body_name(model, state.fingers[f].body);
+    fs.phase = state.fingers[f].phase;
     fs.slip = slip[f];
-    s.fingers.push_back(std::move(fs));
   }
+}
+
+scripting::Snapshot snapshot(const Simulation& sim, const TickRecord& last,
+                             const std::vector<double>& slip) {
+  scripting::Snapshot s;
+  fill_snapshot(sim, last, slip, s);
   return s;
 }
 
@@ -142,6 +150,15 @@ RunResult run_scenario(const scripting::Scenario& scenario, const RunOptions& op
       result.expectations.push_back({e.what, false, "not checked: the run stopped before it was due"});
     std::size_t next_due = 0;
     scripting::Snapshot initial;
+    // The read-only view trajectory functions get: the state as the last physics tick left it
+    // (before the first tick: the initial state, fingers at zero and free). Updated only when a
+    // physics tick ran, and only if some trajectory function takes it.
+    const bool view = scenario.uses_view();
+    scripting::Snapshot view_state;
+    if (view) {
+      fill_snapshot(sim, record, slip, view_state);
+      scenario.update_view(view_state);
+    }
     const auto check_due = [&](std::int64_t tick) {
       while (next_due < due.size() && due[next_due].first == tick) {
         const std::size_t i = due[next_due].second;
@@ -184,6 +201,10 @@ RunResult run_scenario(const scripting::Scenario& scenario, const RunOptions& op
         for (std::size_t f = 0; f < slip.size(); ++f) slip[f] += record.haptic[f].slip;
       }
       result.physics_ticks += record.physics_ran;
+      if (view && record.physics_ran) {
+        fill_snapshot(sim, record, slip, view_state);
+        scenario.update_view(view_state);
+      }
       // Wall-clock checks only every 3000 ticks: they are the only clock reads in the loop.
       if (n % 3000 == 2999) {
         if (options.interrupt && options.interrupt->load()) {

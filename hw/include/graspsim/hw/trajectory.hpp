@@ -1,4 +1,4 @@
-// Trajectories for scripted fingers: the HIP position as a function of time.
+// Trajectories for scripted fingers: the HIP position (and the stylus gimbal) as a function of time.
 #pragma once
 
 #include <memory>
@@ -8,17 +8,25 @@
 
 namespace graspsim::hw {
 
+// What a trajectory gives for one instant.
+struct TrajectorySample {
+  Vec3 position{0.0, 0.0, 0.0};   // m, world: the HIP
+  Vec3 gimbal{0.0, 0.0, 0.0};     // rad: stylus gimbal (roll, pitch, yaw); scripts set the pitch
+};
+
 class Trajectory {
  public:
   virtual ~Trajectory() = default;
-  // HIP position (m, world) at time t (s). Throws on a script error or a NaN t; never
-  // returns a non-finite position.
-  virtual Vec3 position(double t) = 0;
+  // HIP position and gimbal at time t (s). Throws on a script error or a NaN t; never returns
+  // a non-finite value.
+  virtual TrajectorySample sample(double t) = 0;
+  Vec3 position(double t) { return sample(t).position; }   // m, world
 };
 
 struct Waypoint {
   double time = 0.0;              // s
   Vec3 position{0.0, 0.0, 0.0};   // m, world
+  double pitch = 0.0;             // rad: gimbal pitch, interpolated like the position
 };
 
 enum class Interpolation {
@@ -32,7 +40,7 @@ class WaypointTrajectory final : public Trajectory {
  public:
   // Throws std::invalid_argument when empty or when times do not increase.
   WaypointTrajectory(std::vector<Waypoint> waypoints, Interpolation interpolation);
-  Vec3 position(double t) override;
+  TrajectorySample sample(double t) override;
 
  private:
   std::vector<Waypoint> waypoints_;

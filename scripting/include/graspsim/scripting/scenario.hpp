@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "graspsim/engine/model.hpp"
+#include "graspsim/engine/state.hpp"
 #include "graspsim/hw/device.hpp"
 #include "graspsim/hw/trajectory.hpp"
 #include "graspsim/scripting/error.hpp"        // ScenarioError
@@ -52,6 +53,7 @@ struct FingerSnapshot {
   Vec3 god_object{0.0, 0.0, 0.0};   // m, world
   Vec3 force{0.0, 0.0, 0.0};        // N, world, on the finger (last haptic tick)
   std::string touching;             // name of the contacted object, "floor" or "" (free)
+  ContactPhase phase = ContactPhase::kFree;   // friction-cone phase ("free", "stick", "slip")
   double slip = 0.0;                // m: total distance its god-object slid over surfaces so far
 };
 struct Snapshot {
@@ -93,6 +95,14 @@ class Scenario {
   // it runs are thrown as ScenarioError with file:line and a traceback.
   std::unique_ptr<hw::Trajectory> make_trajectory(std::size_t finger) const;
 
+  // True when some trajectory function takes a second parameter (or ...): only then does the
+  // run loop need to keep the view up to date.
+  bool uses_view() const { return uses_view_; }
+  // Writes `now` into the read-only view that trajectory functions get as their second argument
+  // (the runner calls it before the first tick and after every physics tick). Allocates only the
+  // first time.
+  void update_view(const Snapshot& now) const;
+
   // Checks expectation i against `now` (and `initial`, the snapshot at t = 0).
   ExpectationResult check(std::size_t expectation, const Snapshot& now,
                           const Snapshot& initial) const;
@@ -106,6 +116,7 @@ class Scenario {
   std::vector<FingerSetup> fingers_;
   std::vector<Expectation> expectations_;
   std::vector<std::string> parameters_;
+  bool uses_view_ = false;
   // Finger trajectories: waypoints, or a registry ref to a Lua function (0 when waypoints).
   struct TrajectorySpec {
     std::vector<hw::Waypoint> waypoints;
