@@ -72,8 +72,9 @@ std::optional<BoxEntry> box_entry(const Vec3& h, const Vec3& a, const Vec3& b) {
     t_exit = std::min(t_exit, t_far);
   }
   // a is outside, so some slab is entered at t > 0; the path must reach it (t <= 1) and be in
-  // all slabs at once (t_enter <= t_exit).
-  if (face < 0 || t_enter > t_exit || t_enter > 1.0) return std::nullopt;
+  // all slabs at once (t_enter <= t_exit), and ahead of a, not behind it (t_exit >= 0: a finger
+  // moving away from a face it has just left crosses the box only on the line behind it).
+  if (face < 0 || t_enter > t_exit || t_enter > 1.0 || t_exit < 0.0) return std::nullopt;
   Vec3 p = a + t_enter * d;
   const int axis = face / 2;
   p[axis] = (face % 2 == 0 ? 1.0 : -1.0) * h[axis];   // exactly on the face plane

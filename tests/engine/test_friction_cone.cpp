@@ -199,6 +199,10 @@ TEST_CASE("box_entry finds the face a path enters", "[collision]") {
   CHECK(e->t == Approx(0.5));
   // Ends outside: no contact.
   CHECK_FALSE(box_entry(h, Vec3(0.0, 0.5, 0.0), Vec3(0.0, 0.25, 0.0)));
+  // Moving away from a face just left: the box lies behind the path (entry and exit at t < 0),
+  // nothing is entered. (Once reported as an entry through the far face, 8 cm away.)
+  CHECK_FALSE(box_entry(h, Vec3(0.1 + 1e-4, 0.0, 0.0), Vec3(0.12, 0.0, 0.0)));
+  CHECK_FALSE(box_entry(h, Vec3(0.0, 0.0, 0.31), Vec3(0.01, 0.02, 0.4)));
   // Starts inside: the face nearest the end point (-z, depth 0.01).
   e = box_entry(h, Vec3(0.0, 0.0, 0.0), Vec3(0.0, 0.0, -0.29));
   REQUIRE(e);
