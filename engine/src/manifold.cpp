@@ -38,6 +38,15 @@ FaceQuery query_faces(const ConvexPolyhedron& p, const Vec3& x, const Mat3& r, c
 
 // Closest points of the segments p0-p1 and q0-q1; false when they are parallel or the closest
 // points of the two lines fall outside either segment (then the edges do not meet as edges).
+// Gregorius' Gauss-map test: the arcs a-b (normals of A's two faces at its edge) and c-d (the
+// negated normals of B's two faces at its edge) cross on the unit sphere, so the two edges form
+// a face of the Minkowski difference A - B and their cross product is a candidate axis.
+bool minkowski_face(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
+  const Vec3 bxa = b.cross(a), dxc = d.cross(c);
+  const double cba = c.dot(bxa), dba = d.dot(bxa), adc = a.dot(dxc), bdc = b.dot(dxc);
+  return cba * dba < 0.0 && adc * bdc < 0.0 && cba * bdc > 0.0;
+}
+
 bool edge_closest(const Vec3& p0, const Vec3& p1, const Vec3& q0, const Vec3& q1, Vec3& cp, Vec3& cq) {
   const Vec3 d1 = p1 - p0, d2 = q1 - q0, r = p0 - q0;
   const double a = d1.dot(d1), e = d2.dot(d2), b = d1.dot(d2), c = d1.dot(r), f = d2.dot(r);
@@ -60,7 +69,9 @@ HullEdges hull_edges(const ConvexPolyhedron& hull) {
     h.max_face_vertices = std::max(h.max_face_vertices, n);
     for (int i = 0; i < n; ++i) {
       const int a = f.vertices[i], b = f.vertices[(i + 1) % n];
-      if (a < b) h.edges.push_back({a, b});   // each edge appears once as a < b in a closed hull
+      const int here = static_cast<int>(&f - hull.faces.data());
+      // Each edge of a closed hull appears once as a < b.
+      if (a < b) h.edges.push_back({a, b, here, f.neighbours.empty() ? -1 : f.neighbours[i]});
     }
   }
   std::sort(h.edges.begin(), h.edges.end());
@@ -97,7 +108,13 @@ int manifold(const HullEdges& ha, const Vec3& xa, const Mat3& ra, const HullEdge
   Vec3 edge_axis = Vec3::Zero();
   for (int i = 0; i < static_cast<int>(ha.edges.size()); ++i) {
     const Vec3 da = s.world_a[ha.edges[i][1]] - s.world_a[ha.edges[i][0]];
+    const bool faces_a = ha.edges[i][3] >= 0;
+    const Vec3 ua = faces_a ? Vec3(ra * a.faces[ha.edges[i][2]].normal) : Vec3::Zero();
+    const Vec3 va = faces_a ? Vec3(ra * a.faces[ha.edges[i][3]].normal) : Vec3::Zero();
     for (int j = 0; j < static_cast<int>(hb.edges.size()); ++j) {
+      if (faces_a && hb.edges[j][3] >= 0 &&
+          !minkowski_face(ua, va, -(rb * b.faces[hb.edges[j][2]].normal), -(rb * b.faces[hb.edges[j][3]].normal)))
+        continue;
       const Vec3 db = s.world_b[hb.edges[j][1]] - s.world_b[hb.edges[j][0]];
       Vec3 axis = da.cross(db);
       const double len = axis.norm();

@@ -24,7 +24,8 @@ struct ManifoldPoint {
 // A convex polyhedron with its edges listed once (a < b), for the edge-edge axes.
 struct HullEdges {
   const ConvexPolyhedron* hull = nullptr;
-  std::vector<std::array<int, 2>> edges;   // vertex index pairs
+  std::vector<std::array<int, 4>> edges;   // vertex indices a < b, then the two faces that meet
+                                           // there (for the Gauss-map test)
   int max_face_vertices = 0;
 };
 HullEdges hull_edges(const ConvexPolyhedron& hull);
@@ -48,7 +49,9 @@ inline constexpr int kMaxManifoldPoints = 16;
 // with the least penetration, A preferred unless B's is clearly less (Box2D's 0.98 relative
 // tolerance, so that the choice does not flicker on a resting stack); an edge-edge contact gives
 // one point, at the middle of the two edges' closest points, used only when its axis separates
-// clearly more than any face axis and the closest points lie within both edges.
+// clearly more than any face axis and the closest points lie within both edges. Only edge pairs
+// that form a face of the Minkowski difference are tested (Gregorius' Gauss-map test): an edge
+// lying on the other body's face is a face contact, never an edge contact that flickers with it.
 int manifold(const HullEdges& a, const Vec3& xa, const Mat3& ra, const HullEdges& b, const Vec3& xb,
              const Mat3& rb, ManifoldScratch& scratch, ManifoldPoint* out, int capacity);
 
