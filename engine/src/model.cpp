@@ -119,6 +119,25 @@ std::vector<std::string> stability_warnings(const Model& model) {
       check("object '" + b.name + "' on the floor", 12.0 * pair.stiffness / b.mass, 12.0 * pair.damping / b.mass);
     }
   }
+  //  - two bodies pressed together (a box on a box): the lighter rocking on its corners on the
+  //    other, which moves too: the floor's estimate with the reduced mass m_a m_b / (m_a + m_b).
+  //    A pair that is rigid on both sides (infinite stiffness or damping) does not collide.
+  const int n = static_cast<int>(model.bodies.size());
+  for (int a = 0; a < n; ++a) {
+    for (int b = a + 1; b < n; ++b) {
+      const BodyParams& pa = model.bodies[a];
+      const BodyParams& pb = model.bodies[b];
+      const ContactPair pair = contact_pair(pa.material, pb.material);
+      const std::string what = "objects '" + pa.name + "' and '" + pb.name + "'";
+      if (std::isinf(pair.stiffness) || std::isinf(pair.damping)) {
+        out.push_back(what + " are both rigid (infinite stiffness or damping): they pass through each other; "
+                      "give one of them a finite material stiffness and damping to make them collide");
+        continue;
+      }
+      const double reduced = pa.mass * pb.mass / (pa.mass + pb.mass);
+      check(what + " in contact", 12.0 * pair.stiffness / reduced, 12.0 * pair.damping / reduced);
+    }
+  }
   return out;
 }
 

@@ -1,6 +1,8 @@
 // The tick: devices, finger contact, forces, physics, in one fixed order.
 #include "graspsim/engine/simulation.hpp"
 
+#include <algorithm>
+
 #include "graspsim/engine/finger_contact.hpp"
 #include "graspsim/engine/grasp_rules.hpp"
 #include "graspsim/engine/integrate.hpp"
@@ -19,7 +21,10 @@ Simulation::Simulation(Model model)
     : model_(validated(std::move(model))),
       divisors_(graspsim::divisors(model_.rates)),
       state_(initial_state(model_)),
-      collision_(model_) {
+      collision_(model_),
+      body_contacts_(model_),
+      contact_wrench_(model_.bodies.size()),
+      contact_points_(model_.bodies.size(), 0) {
   collision_.update(state_);
   scratch_.reserve(model_.bodies.size());
 }
@@ -73,12 +78,18 @@ void Simulation::step(const Input& input, TickRecord& record) {
     // for one servo period, so the body gets sum(f) / servo = mean(f) * dt. (Dividing by the
     // ticks actually accumulated would apply tick 0's force for a whole step.)
     const double per_tick = 1.0 / static_cast<double>(divisors_.physics);
+    // Body against body first, every pair at the state of this tick (equal and opposite).
+    std::fill(contact_wrench_.begin(), contact_wrench_.end(), Wrench{});
+    std::fill(contact_points_.begin(), contact_points_.end(), 0);
+    body_contacts_.step(model_, state_, contact_wrench_, contact_points_);
     for (std::size_t b = 0; b < model_.bodies.size(); ++b) {
       const BodyParams& bp = model_.bodies[b];
       BodyState& bs = state_.bodies[b];
       Wrench floor;
       int floor_contacts = 0;
       if (model_.floor.enabled) floor_contacts = floor_contact(model_, static_cast<int>(b), bs, floor);
+      floor.force += contact_wrench_[b].force;   // from here on: every object contact
+      floor.torque += contact_wrench_[b].torque;
       const Vec3 force = bs.window_force * per_tick + floor.force + bp.mass * model_.gravity;
       Vec3 torque = bs.window_torque * per_tick + floor.torque;
 
@@ -88,6 +99,7 @@ void Simulation::step(const Input& input, TickRecord& record) {
       rec.velocity = bs.velocity;
       rec.angular_velocity = bs.angular_velocity;
       rec.floor_contacts = floor_contacts;
+      rec.body_contacts = contact_points_[b];
       rec.grasp_area = 0.0;
       rec.torsion = 0.0;
       rec.twist = 0.0;

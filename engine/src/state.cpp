@@ -1,6 +1,7 @@
 // The initial State and the sizing of per-tick records.
 #include "graspsim/engine/state.hpp"
 
+#include "graspsim/engine/object_contact.hpp"
 #include "graspsim/engine/record.hpp"
 
 namespace graspsim {
@@ -15,7 +16,10 @@ State initial_state(const Model& model) {
     b.rotation = p.orientation.normalized().toRotationMatrix();
     b.velocity = p.velocity;
     b.angular_velocity = p.angular_velocity;
+    b.floor_contacts.resize(static_cast<std::size_t>(floor_point_count(p.shape)));
   }
+  const std::size_t n = model.bodies.size();
+  s.pairs.resize(n * (n > 0 ? n - 1 : 0) / 2);
   s.fingers.resize(model.fingers.size());
   return s;
 }

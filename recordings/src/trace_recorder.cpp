@@ -79,6 +79,7 @@ TraceRecorder::TraceRecorder(TraceWriter& writer, const graspsim::Model& model)
     o.force = physics_.add_column(p + "force", 3, DType::kFloat64, "N");
     o.torque = physics_.add_column(p + "torque", 3, DType::kFloat64, "N m");
     o.floor_contacts = physics_.add_column(p + "floor_contacts", 1, DType::kInt32, "1");
+    o.body_contacts = physics_.add_column(p + "body_contacts", 1, DType::kInt32, "1");
     o.grasp_area = physics_.add_column(p + "grasp_area", 1, DType::kFloat64, "m^2");
     o.torsion = physics_.add_column(p + "torsion", 1, DType::kFloat64, "N m");
     o.twist = physics_.add_column(p + "twist", 1, DType::kFloat64, "rad");
@@ -142,6 +143,7 @@ void TraceRecorder::record(const graspsim::TickRecord& rec,
       put(row, c.force, b.force);
       put(row, c.torque, b.torque);
       row[c.floor_contacts] = static_cast<double>(b.floor_contacts);
+      row[c.body_contacts] = static_cast<double>(b.body_contacts);
       row[c.grasp_area] = b.grasp_area;
       row[c.torsion] = b.torsion;
       row[c.twist] = b.twist;

@@ -105,6 +105,7 @@ void fill(TickRecord& rec, std::vector<Vec3>& rendered, std::int64_t tick) {
   b.force = v3(tick, 0, 4);
   b.torque = v3(tick, 0, 5);
   b.floor_contacts = static_cast<int>(tick / 10 % 9);
+  b.body_contacts = static_cast<int>(tick / 10 % 7);
   b.grasp_area = v(tick, 0, 6, 0);
   b.torsion = v(tick, 0, 6, 1);
   b.twist = v(tick, 0, 6, 2);
@@ -231,6 +232,8 @@ TEST_CASE("the recorder writes the schema with exact values at each loop's rate"
   check(file, o + "torque", {np, 3}, DType::kFloat64, "N m", column(physics_ticks, 3, body(5)));
   check(file, o + "floor_contacts", {np}, DType::kInt32, "1",
         column(physics_ticks, 1, [](std::int64_t t, int) { return double(t / 10 % 9); }));
+  check(file, o + "body_contacts", {np}, DType::kInt32, "1",
+        column(physics_ticks, 1, [](std::int64_t t, int) { return double(t / 10 % 7); }));
   check(file, o + "grasp_area", {np}, DType::kFloat64, "m^2",
         column(physics_ticks, 1, [](std::int64_t t, int) { return v(t, 0, 6, 0); }));
   check(file, o + "torsion", {np}, DType::kFloat64, "N m",

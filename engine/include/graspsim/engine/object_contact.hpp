@@ -1,8 +1,13 @@
 // Object contact: the paper's penalty "rotate down" contact of a body with the floor (section
-// 4), one force per penetrating vertex, with damping so that energy is lost, and friction by a
-// stick anchor per vertex (the friction circle of section 2, applied to object contact).
+// 4), one force per penetrating floor point, with damping so that energy is lost, and friction by
+// a stick anchor per point (the friction circle of section 2, applied to object contact); and the
+// same penalty law between bodies, point by point over a contact manifold (manifold.hpp).
 #pragma once
 
+#include <memory>
+#include <vector>
+
+#include "graspsim/engine/manifold.hpp"
 #include "graspsim/engine/math.hpp"
 #include "graspsim/engine/model.hpp"
 #include "graspsim/engine/state.hpp"
@@ -17,13 +22,56 @@ struct Wrench {
 // The eight corners of a box in its body frame, in a fixed order (x fastest, then y, then z).
 Vec3 box_vertex(const Vec3& half_extents, int k);
 
-// Floor wrench on body b at its current state, updating its vertices' friction anchors.
-// For each vertex at depth d > 0 below the floor, moving at u:
+// Floor points per shape kind: box 8 corners; convex hull and mesh their vertices; sphere its
+// lowest point; capsule the lowest points of its two end spheres; cylinder 12 points on each cap's
+// rim (a 12-sided prism: caps of every orientation rest on them, exactly when lying flat).
+inline constexpr int kCylinderRimPoints = 12;
+int floor_point_count(const Shape& shape);
+
+// Floor point k of a body turned by `rotation`, as an offset (m, world) from its centre of mass.
+// `rolling` says the point is not a fixed material point but the lowest point of a round surface
+// (sphere, capsule end), which the body rolls over.
+Vec3 floor_point(const Shape& shape, const Mat3& rotation, int k, bool& rolling);
+
+// Floor wrench on body b at its current state, updating its points' friction anchors.
+// For each floor point at depth d > 0 below the floor, whose material moves at u:
 //   normal      f_n = max(0, k d - c u_n)                      (no pull)
 //   friction    anchor a kept while |a - x_t| <= mu f_n / k, else moved onto that circle;
 //               f_t = k (a - x_t) - c u_t, scaled down to |f_t| <= mu f_n
-// where x_t is the vertex projected on the floor and (k, c, mu) = contact_pair(body, floor).
-// Returns the number of vertices in contact.
+// where x_t is the material point projected on the floor and (k, c, mu) = contact_pair(body,
+// floor). A rolling point's material point is the one under it at the last step; after the step
+// the anchor is carried over to the new lowest point with the same stretch a - x_t, so a ball
+// rolling without slip feels no friction and one that slides does.
+// Returns the number of points in contact.
 int floor_contact(const Model& model, int body, BodyState& bs, Wrench& out);
+
+// Body-body contact. Keeps its own FCL objects of the bodies (a dynamic AABB tree) for the
+// broadphase. Pairs of polyhedra (box, convex) get a clipped manifold (manifold.hpp); every other
+// pair (sphere, capsule, cylinder, mesh) gets FCL's contacts (collide with contacts; for meshes
+// its BVH triangle contacts), sorted by position. Each point gets the floor's law: penalty
+// f_n = max(0, k d - c u_n) with the two materials in series, friction by anchors that are a
+// material point of each body (stick_slip_step), equal and opposite on the two bodies at the same
+// point. A pair whose materials are both rigid (infinite stiffness or damping) does not collide
+// (stability_warnings() says so).
+class BodyContacts {
+ public:
+  explicit BodyContacts(const Model& model);
+  ~BodyContacts();
+  BodyContacts(BodyContacts&&) noexcept;
+  BodyContacts& operator=(BodyContacts&&) noexcept;
+
+  // Adds every body-body contact wrench at the current state to `wrenches[b]` and the number of
+  // contact points of b to `points[b]` (both sized to the bodies, not cleared), and updates the
+  // pairs' friction anchors in `state.pairs`. Allocation-free for pairs of polyhedra.
+  void step(const Model& model, State& state, std::vector<Wrench>& wrenches, std::vector<int>& points);
+
+  // The contact points of bodies a < b at `state` (no friction update), into `out` (capacity
+  // kMaxPairPoints). For tests and energy accounting.
+  int points(const Model& model, const State& state, int a, int b, ManifoldPoint* out);
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
 
 }  // namespace graspsim

@@ -45,7 +45,8 @@ struct BodyRecord {
   Vec3 angular_velocity{0.0, 0.0, 0.0};   // rad/s, world
   Vec3 force{0.0, 0.0, 0.0};              // N, world: residual force applied this step
   Vec3 torque{0.0, 0.0, 0.0};             // N m, world: residual torque about the centre of mass
-  int floor_contacts = 0;                 // 1: vertices touching the floor
+  int floor_contacts = 0;                 // 1: floor points (vertices) touching the floor
+  int body_contacts = 0;                  // 1: contact points with other bodies
   double grasp_area = 0.0;                // m^2: friction-circle area A of a two-finger grasp
                                           //      (0 when not held by exactly two fingers)
   double torsion = 0.0;                   // N m: gravity-drop torque about the grasp axis

@@ -6,6 +6,7 @@
 
 #include "graspsim/engine/collision.hpp"
 #include "graspsim/engine/model.hpp"
+#include "graspsim/engine/object_contact.hpp"
 #include "graspsim/engine/record.hpp"
 #include "graspsim/engine/state.hpp"
 
@@ -22,9 +23,10 @@ class Simulation {
   //   3 servo    force on every finger, k (GO - HIP) with the newest HIP; its reaction, acting at
   //              the contact point on the surface (GO less the pad radius), is added to the
   //              contacted body's physics window
-  //   4 physics  (tick % (servo/physics) == 0) for every body, in body order: record the state at
-  //              this tick; residual F = finger impulse over the window / dt + floor + m g and
-  //              T = finger angular impulse / dt + floor torque; integrate over dt = 1/physics s;
+  //   4 physics  (tick % (servo/physics) == 0): body-body contact wrenches for every pair in
+  //              contact, all at the state of this tick; then for every body, in body order: record
+  //              the state at this tick; residual F = finger impulse over the window / dt + floor +
+  //              other bodies + m g and T likewise; integrate over dt = 1/physics s;
   //              clear the window; flag a body whose state diverged (see record.hpp)
   //   5 tick += 1
   // Time is tick / servo, computed, never accumulated.
@@ -42,6 +44,9 @@ class Simulation {
   State state_;
   CollisionWorld collision_;
   std::vector<int> scratch_;   // candidate bodies of a finger query
+  BodyContacts body_contacts_;            // body-body contact (its own broadphase)
+  std::vector<Wrench> contact_wrench_;    // per body: body-body contact wrench of this step
+  std::vector<int> contact_points_;       // per body: body-body contact points of this step
 };
 
 }  // namespace graspsim

@@ -36,20 +36,46 @@ struct FingerState {
   bool has_pitch = false;                   // false until the first physics step
 };
 
-// One vertex of a body against the floor: its friction anchor (the paper's god-object idea
-// applied to object contact) while the vertex penetrates.
+// One floor point of a body (a vertex, or the lowest point of a sphere) against the floor: its
+// friction anchor (the paper's god-object idea applied to object contact) while it penetrates.
 struct VertexContact {
   bool active = false;
   bool slipping = false;          // the anchor moved at the last step: kinetic friction applies
-  Vec3 anchor{0.0, 0.0, 0.0};   // m, world: where the vertex stuck to the floor
+  Vec3 anchor{0.0, 0.0, 0.0};   // m, world: where the point stuck to the floor
+  Vec3 material{0.0, 0.0, 0.0};   // m, body frame: the body's material point under a rolling
+                                  //    contact (sphere, capsule end) at the last step
 };
+
+// One point of a contact manifold between two bodies A < B: its friction anchor, as a material
+// point of each body, kept from step to step while the same features touch (matched by key).
+struct PairPointContact {
+  std::uint64_t key = 0;          // feature id (manifold.hpp)
+  bool slipping = false;          // the anchors slid at the last step: kinetic friction applies
+  Vec3 anchor_a{0.0, 0.0, 0.0};   // m, A's body frame: A's stuck point
+  Vec3 anchor_b{0.0, 0.0, 0.0};   // m, B's body frame: B's stuck point
+};
+
+inline constexpr int kMaxPairPoints = 16;   // contact points kept per body pair
+
+// The contact of two bodies A < B (by index).
+struct PairContact {
+  int count = 0;                                       // points in contact at the last step
+  std::array<PairPointContact, kMaxPairPoints> points{};
+};
+
+// Index of the pair (a, b), a < b, among n bodies in State::pairs: (0,1), (0,2), ..., (1,2), ...
+inline std::size_t pair_index(int a, int b, int n) {
+  return static_cast<std::size_t>(a) * static_cast<std::size_t>(2 * n - a - 1) / 2 +
+         static_cast<std::size_t>(b - a - 1);
+}
 
 struct BodyState {
   Vec3 position{0.0, 0.0, 0.0};           // m: centre of mass, world
   Mat3 rotation = Mat3::Identity();       // 1: body to world (R = [n o a])
   Vec3 velocity{0.0, 0.0, 0.0};           // m/s, world
   Vec3 angular_velocity{0.0, 0.0, 0.0};   // rad/s, world
-  std::array<VertexContact, 8> floor_contacts{};   // box vertices against the floor
+  std::vector<VertexContact> floor_contacts;   // one per floor point of the shape (object_contact.hpp),
+                                               // sized by initial_state
   // Finger wrench accumulated over the current physics window (sum over servo ticks).
   Vec3 window_force{0.0, 0.0, 0.0};       // N (summed; divided by servo/physics ticks)
   Vec3 window_torque{0.0, 0.0, 0.0};      // N m about the centre of mass (summed)
@@ -59,6 +85,7 @@ struct State {
   std::int64_t tick = 0;              // servo ticks done; time = tick / servo rate
   std::vector<BodyState> bodies;      // same order as Model::bodies
   std::vector<FingerState> fingers;   // same order as Model::fingers
+  std::vector<PairContact> pairs;     // every body pair a < b, at pair_index(a, b, bodies)
 };
 
 // The state at t = 0 given by the model's initial conditions.

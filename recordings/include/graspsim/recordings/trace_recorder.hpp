@@ -37,7 +37,7 @@ class TraceRecorder {
   };
   struct PhysicsColumns {
     std::size_t position, quaternion, velocity, angular_velocity, force, torque, floor_contacts,
-        grasp_area, torsion, twist;
+        body_contacts, grasp_area, torsion, twist;
   };
   struct TimeColumns {
     std::size_t tick;   // offset of tick
