@@ -150,6 +150,8 @@ std::optional<double> convex_entry_t(const Shape& s, double r, const Vec3& a, co
 // ---------------------------------------------------------------------------------------------
 // Polygonal surfaces: the god-object walk.
 
+const Vec3& F_normal(const SurfaceGeometry& g, int f) { return g.face(f).normal; }
+
 double plane_gap(const SurfaceGeometry& g, double r, int f, const Vec3& x) {
   const auto& F = g.face(f);
   return F.normal.dot(x) - (F.offset + r);   // > 0 outside the face's (offset) plane
@@ -262,6 +264,16 @@ bool walk(const SurfaceGeometry& g, double r, bool glued, const Vec3& h, Vec3& p
         const double t = std::max(sp, 0.0) / (sp - sg);
         if (t > t_hit || (t == t_hit && hit >= 0 && c > hit)) continue;
         if (!in_polygon(g, r, c, p + t * d, kTol)) continue;
+        // Met on one of its edges while moving out past that edge (from a convex edge onto the
+        // next face, below the first one's plane extended): not entered.
+        bool leaving = false;
+        const Vec3 q = p + t * d - r * F_normal(g, c);
+        for (int j = 0; j < g.face(c).count && !leaving; ++j) {
+          const int e = g.face(c).first + j;
+          leaving = std::abs(g.edge_normal(e).dot(q - g.corner(e))) <= kTol &&
+                  g.edge_normal(e).dot(d) < -1e-9 * d.norm();
+        }
+        if (leaving) continue;
         t_hit = t;
         hit = c;
       }
@@ -278,8 +290,21 @@ bool walk(const SurfaceGeometry& g, double r, bool glued, const Vec3& h, Vec3& p
       p += t_exit * d;
       const int left = S.ids[exit_slot];
       remove_at(S, exit_slot);
+      const int dropped_before = dropped;
       dropped = left;
       const int across = g.neighbour(exit_edge);
+      if (S.count == 0 && across >= 0 && across == dropped_before && t_exit * d.norm() <= kTol &&
+          plane_gap(g, r, left, h) < 0.0 && plane_gap(g, r, across, h) < 0.0) {
+        // Back at once over the edge just crossed, the HIP below both faces: the god-object
+        // stays on the edge. For a point (r = 0) both planes hold it there (the multipliers
+        // release it); for a pad the offset planes meet outside, at the mitre: it stops here.
+        S.count = 1;
+        S.ids[0] = left;
+        if (r > 0.0) break;
+        S.count = 2;
+        S.ids[1] = across;
+        continue;
+      }
       if (S.count == 0 && across >= 0) {
         p += r * (g.face(across).normal - g.face(left).normal);
         S.count = 1;
@@ -388,7 +413,10 @@ std::optional<SurfaceEntry> surface_entry(const SurfaceGeometry& g, double r, co
     case ShapeKind::kCylinder: {
       const auto t = convex_entry_t(s, r, a, b);
       if (!t) return std::nullopt;
-      const Vec3 x = a + *t * (b - a);
+      // Already inside at a (the body moved onto the finger, or the first tick): from b, as
+      // the box does; else the entry point, nudged 1e-9 m along the path so it is inside.
+      const bool from_inside = core_signed_distance(s, a) - r <= 0.0;
+      const Vec3 x = from_inside ? b : Vec3(a + *t * (b - a));
       // The entry point lies on the grown surface (to the bisection's tolerance): the closest
       // point there gives SP, normal and feature. No history yet: the outward direction from
       // the core's centre stands in for it.
@@ -399,7 +427,7 @@ std::optional<SurfaceEntry> surface_entry(const SurfaceGeometry& g, double r, co
           s.half_length - std::abs(x.z()) < s.radius - std::hypot(x.x(), x.y())) {
         feature = x.z() > 0.0 ? 1 : 2;
       }
-      const Vec3 inward = x - 1e-9 * (b - a).normalized();   // just inside: depth > 0
+      const Vec3 inward = from_inside ? x : Vec3(x + 1e-9 * (b - a).normalized());
       const bool ok = s.kind == ShapeKind::kCylinder ? track_cylinder(s, r, feature, hint, inward, tr)
                                                      : track_round(s, r, hint, inward, tr);
       if (!ok) return std::nullopt;
@@ -414,8 +442,8 @@ std::optional<SurfaceEntry> surface_entry(const SurfaceGeometry& g, double r, co
       int face = -1;
       for (int f = 0; f < g.face_count(); ++f) {
         const double sa = plane_gap(g, r, f, a), sb = plane_gap(g, r, f, b);
-        if (sa < 0.0 || !(sb < 0.0)) continue;
-        const double t = sa / (sa - sb);
+        if (sa < -kTol || !(sb < 0.0)) continue;   // a on the plane (to rounding) counts as outside
+        const double t = std::max(sa, 0.0) / (sa - sb);
         if (t >= best) continue;
         if (!in_polygon(g, r, f, a + t * (b - a), r + kTol)) continue;
         best = t;
@@ -453,10 +481,13 @@ bool surface_track(const SurfaceGeometry& g, double r, const Features& features,
       if (!walk(g, r, false, hip, p, S)) return false;
       const Vec3 d = p - hip;
       const double depth = d.norm();
-      if (!(depth > kTol)) return false;   // on the surface: touching, no force
+      if (!(depth > 0.0)) return false;   // on the surface: touching, no force
       out.point = p;
       out.depth = depth;
-      out.normal = S.count == 1 ? g.face(S.ids[0]).normal : Vec3(d / depth);
+      // One plane: its normal (exactly); held by an edge or a corner (or stopped on one): the
+      // direction from the HIP to SP, which is the force's direction.
+      const Vec3& n0 = g.face(S.ids[0]).normal;
+      out.normal = S.count == 1 && n0.dot(d) >= depth * (1.0 - 1e-12) ? n0 : Vec3(d / depth);
       out.features = S;
       return true;
     }
