@@ -1,6 +1,7 @@
 // The friction cone algorithm of Melder, Harwin & Sharkey, section 2, per finger.
 #include "graspsim/engine/finger_contact.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 namespace graspsim {
@@ -20,6 +21,12 @@ Frame contact_frame(const State& state, int body) {
 
 const Material& surface_material(const Model& model, int body) {
   return body >= 0 ? model.bodies[body].material : model.floor.material;
+}
+
+// The circle a GO that slipped this tick lies on: the static one the tick it breaks away,
+// else the kinetic one (see finger_haptic_step).
+double sliding_radius(bool was_slipping, double static_radius, double kinetic_radius) {
+  return was_slipping ? kinetic_radius : static_radius;
 }
 
 }  // namespace
@@ -139,8 +146,24 @@ void finger_haptic_step(const Model& model, const State& state, const CollisionW
       const Vec3 before = fs.god_object;
       const bool slipped = stick_slip_step(sp, pair.mu * depth, kinetic_radius,
                                            fr.R.transpose() * v_rel_t, was_slipping, fs.god_object);
-      if (slipped && fs.body >= 0) {
-        fs.god_object = surface_project(collision.surface(fs.body), r, tr, fs.god_object);
+      if (slipped && fs.body >= 0 && collision.surface(fs.body).shape().kind != ShapeKind::kBox) {
+        // Projecting a GO that the chord put under a convex edge moves it out, which can take
+        // it a little past the circle: the chord point is then scaled towards SP by s, with
+        // |project(SP + s (GO - SP)) - SP| = radius solved by the secant method (a few
+        // rounds), keeping the largest s found inside the circle (s = 0 is SP itself).
+        const SurfaceGeometry& surface = collision.surface(fs.body);
+        const double circle = sliding_radius(was_slipping, pair.mu * depth, kinetic_radius);
+        const Vec3 chord = fs.god_object - sp;
+        const auto off = [&](double s) {
+          return (surface_project(surface, r, tr, sp + s * chord) - sp).norm() - circle;
+        };
+        double s0 = 0.0, f0 = -circle, s1 = 1.0, f1 = off(1.0), inside = f1 <= 1e-12 * circle ? 1.0 : 0.0;
+        for (int round = 0; round < 8 && inside < 1.0 && std::abs(f1) > 1e-12 * circle; ++round) {
+          const double s2 = std::clamp(s1 - f1 * (s1 - s0) / (f1 - f0), 0.0, 1.0);
+          s0 = s1; f0 = f1; s1 = s2; f1 = off(s2);
+          if (f1 <= 1e-12 * circle) inside = std::max(inside, s1);
+        }
+        fs.god_object = surface_project(surface, r, tr, sp + inside * chord);
       }
       fs.surface_point = sp;
       fs.normal = tr.normal;
