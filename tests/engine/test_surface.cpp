@@ -180,4 +180,17 @@ TEST_CASE("a cylinder with a pad: over the rounded rim from side to cap", "[surf
   CHECK(saw[3]);
   CHECK(saw[1]);
   CHECK(last_nz == Approx(1.0));
+
+  // From the rim into the core through the cap plane (the HIP 3 mm in from the side, 0.5 mm under
+  // the cap): the cap just crossed holds it, SP = (x, y, L + r), depth L + r - z; the side would
+  // give R + r - rho = 8 mm.
+  SurfaceTrack rim;
+  REQUIRE(surface_track(g, r, Features{1, {3, 0, 0}}, Vec3(R + r, 0.0, L), Vec3::UnitX(),
+                        Vec3(R + 0.001, 0.0, L + 0.001), rim));
+  CHECK(rim.features.ids[0] == 3);
+  SurfaceTrack in;
+  REQUIRE(surface_track(g, r, rim.features, rim.point, rim.normal, Vec3(R - 0.003, 0.0, L - 0.0005), in));
+  CHECK(in.features.ids[0] == 1);
+  CHECK(in.depth == Approx(r + 0.0005).margin(1e-15));
+  CHECK((in.point - Vec3(R - 0.003, 0.0, L + r)).norm() < 1e-15);
 }
