@@ -212,6 +212,49 @@ Vec3 constrained_goal(const SurfaceGeometry& g, double r, Features& S, const Vec
   }
 }
 
+// The edge face a shares with face b (the slot in a's corners), or -1.
+int shared_edge(const SurfaceGeometry& g, int a, int b) {
+  const auto& A = g.face(a);
+  for (int j = 0; j < A.count; ++j) if (g.neighbour(A.first + j) == b) return A.first + j;
+  return -1;
+}
+
+// Whether faces a and b meet at a convex edge (b bends away below a's plane).
+bool convex_edge(const SurfaceGeometry& g, int a, int b) {
+  const int e = shared_edge(g, a, b);
+  return e >= 0 && g.edge_normal(e).dot(g.face(b).normal) < -1e-9;
+}
+
+// A pad at the convex edge between faces a and b: the grown surface there is the cylinder of
+// radius r about the edge (the exact Minkowski sum). With e the HIP's closest point on the
+// edge and v = HIP - e = alpha n_a + beta n_b (+ along the edge): both >= 0, the HIP is in the
+// edge's wedge of normals, SP = e + r v/|v| (returns 0; -1 when |v| >= r, the HIP beyond the
+// grown surface: the contact ends, unless `glued`); else SP goes to the offset edge of the face
+// on the HIP's side, e + r n (returns 1, `face` set). Continuous at the wedge's sides.
+int rounded_edge(const SurfaceGeometry& g, double r, int a, int b, const Vec3& h, bool glued,
+                 Vec3& p, int& face) {
+  const int e = shared_edge(g, a, b);
+  const auto& A = g.face(a);
+  const Vec3& c0 = g.corner(e);
+  const Vec3& c1 = g.corner(A.first + (e - A.first + 1) % A.count);
+  const Vec3 t = c1 - c0;
+  const Vec3 on_edge = c0 + std::clamp((h - c0).dot(t) / t.squaredNorm(), 0.0, 1.0) * t;
+  const Vec3 v = h - on_edge;
+  const Vec3& na = A.normal;
+  const Vec3& nb = g.face(b).normal;
+  const double c = na.dot(nb), va = v.dot(na), vb = v.dot(nb);
+  const double alpha = va - c * vb, beta = vb - c * va;   // times 1 / (1 - c^2) > 0
+  if (alpha < 0.0 || beta < 0.0) {
+    face = alpha < 0.0 ? b : a;
+    p = on_edge + r * g.face(face).normal;
+    return 1;
+  }
+  const double dist = v.norm();
+  if (!glued && !(dist < r)) return -1;
+  p = on_edge + r * (dist > kTol ? Vec3(v / dist) : Vec3((na + nb).normalized()));
+  return 0;
+}
+
 // The walk. From p on the surface held by S, towards h: drop the planes h is above (negative
 // multipliers; `glued` keeps at least one), move towards the closest point on the remaining
 // planes, stop where the path first meets another face (from outside: the face is added) or
@@ -222,6 +265,15 @@ Vec3 constrained_goal(const SurfaceGeometry& g, double r, Features& S, const Vec
 // iterations run. Returns whether p is held (false: it reached h in free space).
 bool walk(const SurfaceGeometry& g, double r, bool glued, const Vec3& h, Vec3& p, Features& S) {
   int dropped = -1;
+  if (r > 0.0 && S.count == 2 && convex_edge(g, S.ids[0], S.ids[1])) {
+    // Held on a pad's rounded edge at the last tick: still there, or back onto a face.
+    int face = -1;
+    const int where = rounded_edge(g, r, S.ids[0], S.ids[1], h, glued, p, face);
+    if (where == 0) return true;
+    if (where < 0) { S.count = 0; return false; }
+    S.count = 1;
+    S.ids[0] = face;
+  }
   for (int iter = 0; iter < kMaxWalk; ++iter) {
     std::array<double, kMaxFeatures> lambda{};
     Vec3 goal = constrained_goal(g, r, S, h, lambda);
@@ -297,11 +349,21 @@ bool walk(const SurfaceGeometry& g, double r, bool glued, const Vec3& h, Vec3& p
           plane_gap(g, r, left, h) < 0.0 && plane_gap(g, r, across, h) < 0.0) {
         // Back at once over the edge just crossed, the HIP below both faces: the god-object
         // stays on the edge. For a point (r = 0) both planes hold it there (the multipliers
-        // release it); for a pad the offset planes meet outside, at the mitre: it stops here.
-        S.count = 1;
-        S.ids[0] = left;
-        if (r > 0.0) break;
+        // release it). For a pad the HIP is in the convex edge's wedge of normals, where the
+        // grown surface is the edge's cylinder of radius r: SP lies on it (or the contact
+        // ends, the HIP beyond it).
+        if (r > 0.0) {
+          int face = -1;
+          const int where = rounded_edge(g, r, across, left, h, glued, p, face);
+          if (where < 0) { S.count = 0; break; }
+          S.count = where == 0 ? 2 : 1;
+          S.ids[0] = where == 0 ? across : face;
+          S.ids[1] = left;
+          if (where == 0) break;
+          continue;
+        }
         S.count = 2;
+        S.ids[0] = left;
         S.ids[1] = across;
         continue;
       }

@@ -162,6 +162,56 @@ TEST_CASE("a finger slides over a convex edge onto the next face", "[traversal][
   }
 }
 
+// A pad (r = 4 mm) over the same ridge, 1 mm deep: the grown surface is the faces moved out by r
+// joined by the ridge's cylinder of radius r (the exact Minkowski sum at a convex edge). The HIP
+// runs r - d above the left slope, round the ridge on a circle of radius r - d, and down the
+// right slope. Law: depth d throughout (1e-12 m); SP continuous, moving at most r / (r - d) times
+// as far as the HIP (it runs on radius r where the HIP runs on r - d); on the arc SP is held by
+// both faces, SP = ridge + r (HIP - ridge)/|HIP - ridge|; the normal turns monotonically from
+// n_L to n_R.
+TEST_CASE("a pad goes round a convex edge on its rounded surface, continuously", "[traversal][edge][pad][law]") {
+  const double w = 0.04, h = 0.02, r = 0.004, d = 0.001;
+  const ConvexPolyhedron roof = graspsim::test::wedge(w, h, 0.03);
+  const Vec3 ridge(0.0, 0.001, h);
+  const Vec3 nL = Vec3(-h, 0.0, w).normalized(), nR = Vec3(h, 0.0, w).normalized();
+  const Vec3 tL = Vec3(w, 0.0, h).normalized(), tR = Vec3(w, 0.0, -h).normalized();
+  std::vector<Vec3> path;
+  for (int i = 0; i <= 100; ++i) path.push_back(ridge + (r - d) * nL - tL * (0.01 * (1.0 - i / 100.0)));
+  const double turn = std::acos(nL.dot(nR));
+  const Vec3 across = (nR - nL.dot(nR) * nL).normalized();
+  for (int i = 1; i < 60; ++i) {
+    const double a = turn * i / 60.0;
+    path.push_back(ridge + (r - d) * (std::cos(a) * nL + std::sin(a) * across));
+  }
+  for (int i = 0; i <= 100; ++i) path.push_back(ridge + (r - d) * nR + tR * (0.01 * i / 100.0));
+  for (const Shape& shape : {graspsim::test::convex_shape(roof), graspsim::test::mesh_shape(graspsim::test::triangulate(roof))}) {
+    const SurfaceGeometry g(shape);
+    const auto e = surface_entry(g, r, path.front() + 0.01 * nL, path.front());
+    REQUIRE(e);
+    SurfaceTrack at{e->point, e->normal, 0.0, e->features};
+    Vec3 prev = path.front();
+    double turned = -1.0;   // n . n_R, rising to 1
+    int on_edge = 0;
+    for (const Vec3& hip : path) {
+      SurfaceTrack tr;
+      REQUIRE(surface_track(g, r, at.features, at.point, at.normal, hip, tr));
+      CHECK(tr.depth == Approx(d).margin(1e-12));
+      CHECK((tr.point - (hip + d * tr.normal)).norm() < 1e-12);
+      CHECK((tr.point - at.point).norm() <= (hip - prev).norm() * r / (r - d) * (1.0 + 1e-9) + 1e-12);
+      CHECK(tr.normal.dot(nR) >= turned - 1e-12);
+      turned = tr.normal.dot(nR);
+      if (tr.features.count == 2) {
+        ++on_edge;
+        CHECK((tr.point - (ridge + r * (hip - ridge).normalized())).norm() < 1e-12);
+      }
+      prev = hip;
+      at = tr;
+    }
+    CHECK(on_edge >= 58);
+    CHECK((at.normal - nR).norm() < 1e-12);
+  }
+}
+
 // Across a sphere of R = 5 cm tessellated in 1280 triangles, the finger pressed 2 mm in along a
 // great circle tilted to cross facets at all angles: SP stays on the mesh, so between the inscribed
 // and the circumscribed spheres (R - e <= |SP| <= R, e the largest facet's distance below the
@@ -182,24 +232,27 @@ TEST_CASE("across a tessellated sphere: SP within the tessellation error", "[tra
   }
   const Vec3 axis = Vec3(0.3, 0.2, 1.0).normalized();
   const Vec3 u = axis.cross(Vec3::UnitX()).normalized(), v = axis.cross(u);
-  const auto hip_at = [&](double a) { return (R - d) * (std::cos(a) * u + std::sin(a) * v); };
-  const auto en = surface_entry(g, 0.0, hip_at(0.0) * 1.2, hip_at(0.0));
-  REQUIRE(en);
-  SurfaceTrack at{en->point, en->normal, 0.0, en->features};
-  int crossings = 0;
-  for (int i = 0; i <= 4000; ++i) {
-    const Vec3 hip = hip_at(2.0 * M_PI * i / 4000.0);
-    SurfaceTrack tr;
-    REQUIRE(surface_track(g, 0.0, at.features, at.point, at.normal, hip, tr));
-    const double rho = tr.point.norm();
-    CHECK(rho <= R + 1e-12);
-    CHECK(rho >= R - e - 1e-12);
-    CHECK(std::acos(std::min(1.0, tr.normal.dot(tr.point / rho))) <= facet + 1e-9);
-    CHECK(std::abs(tr.depth - d) <= e + 1e-12);
-    if (tr.features.ids[0] != at.features.ids[0]) ++crossings;
-    at = tr;
+  // A pad of radius r runs on the facets moved out by r: between R - e + r and R + r.
+  for (double r : {0.0, 0.004}) {
+    const auto hip_at = [&](double a) { return (R + r - d) * (std::cos(a) * u + std::sin(a) * v); };
+    const auto en = surface_entry(g, r, hip_at(0.0) * 1.2, hip_at(0.0));
+    REQUIRE(en);
+    SurfaceTrack at{en->point, en->normal, 0.0, en->features};
+    int crossings = 0;
+    for (int i = 0; i <= 4000; ++i) {
+      const Vec3 hip = hip_at(2.0 * M_PI * i / 4000.0);
+      SurfaceTrack tr;
+      REQUIRE(surface_track(g, r, at.features, at.point, at.normal, hip, tr));
+      const double rho = tr.point.norm();
+      CHECK(rho <= R + r + 1e-12);
+      CHECK(rho >= R - e + r - 1e-12);
+      CHECK(std::acos(std::min(1.0, tr.normal.dot(tr.point / rho))) <= facet + 1e-9);
+      CHECK(std::abs(tr.depth - d) <= e + 1e-12);
+      if (tr.features.ids[0] != at.features.ids[0]) ++crossings;
+      at = tr;
+    }
+    CHECK(crossings > 50);
   }
-  CHECK(crossings > 50);
 }
 
 // Concave edge and corner of voxel meshes (cells of 2 cm): an L-shaped solid (floor and wall
