@@ -30,7 +30,7 @@ double axis_inertia(const BodyParams& bp, const BodyState& bs, const Vec3& point
 
 }  // namespace
 
-TwoPointGrasp two_point_grasp(const Model& model, const State& state, int body) {
+TwoPointGrasp two_point_grasp(const Model& /*model*/, const State& state, int body) {
   TwoPointGrasp g;
   int count = 0;
   for (std::size_t f = 0; f < state.fingers.size(); ++f) {

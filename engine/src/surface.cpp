@@ -418,8 +418,13 @@ SurfaceGeometry::SurfaceGeometry(const Shape& shape) : shape_(shape) {
     vertices = shape.mesh->vertices;
     for (const auto& t : shape.mesh->triangles) {
       polys.push_back({t[0], t[1], t[2]});
-      const Vec3 n = (vertices[t[1]] - vertices[t[0]]).cross(vertices[t[2]] - vertices[t[0]]).normalized();
-      planes.emplace_back(n, n.dot(vertices[t[0]]));
+      const Vec3 n = (vertices[t[1]] - vertices[t[0]]).cross(vertices[t[2]] - vertices[t[0]]);
+      if (!(n.norm() > 0.0) || !n.allFinite()) {
+        // A degenerate triangle (no area): a plane no path ever crosses, never held.
+        planes.emplace_back(Vec3::Zero(), kInfinity);
+      } else {
+        planes.emplace_back(n.normalized(), n.normalized().dot(vertices[t[0]]));
+      }
     }
   }
   // Directed edges (a, b, face, corner slot), sorted, to find the face across each edge.
@@ -445,7 +450,8 @@ SurfaceGeometry::SurfaceGeometry(const Shape& shape) : shape_(shape) {
     for (std::size_t i = 0; i < vs.size(); ++i) {
       const int a = vs[i], b = vs[(i + 1) % vs.size()];
       corners_.push_back(vertices[a]);
-      edge_normals_.push_back(F.normal.cross(vertices[b] - vertices[a]).normalized());
+      const Vec3 m = F.normal.cross(vertices[b] - vertices[a]);
+      edge_normals_.push_back(m.norm() > 0.0 ? Vec3(m.normalized()) : Vec3::Zero());
       const auto it = std::lower_bound(edges.begin(), edges.end(), std::make_tuple(b, a, -1, -1));
       neighbours_.push_back(it != edges.end() && std::get<0>(*it) == b && std::get<1>(*it) == a
                                 ? std::get<2>(*it) : -1);
@@ -499,10 +505,27 @@ std::optional<SurfaceEntry> surface_entry(const SurfaceGeometry& g, double r, co
     case ShapeKind::kMesh: {
       // Linear scan: the first face plane (grown by r) crossed from outside inside its polygon
       // (for a pad grown in-plane by r, covering the offset faces' gaps at convex edges; the
-      // point is then moved onto the polygon). A path starting inside enters nothing.
+      // point is then moved onto the polygon). A path starting inside a convex polyhedron (the
+      // body moved onto the finger, or the first tick) takes the face nearest to b, as a box
+      // does; inside a mesh it enters nothing (no inside test for a non-convex mesh).
       double best = kInfinity;
       int face = -1;
-      for (int f = 0; f < g.face_count(); ++f) {
+      if (s.kind == ShapeKind::kConvex) {
+        double gap_a = -kInfinity, gap_b = -kInfinity;
+        int nearest = -1;
+        for (int f = 0; f < g.face_count(); ++f) {
+          gap_a = std::max(gap_a, plane_gap(g, r, f, a));
+          const double gb = plane_gap(g, r, f, b);
+          if (gb > gap_b) { gap_b = gb; nearest = f; }
+        }
+        if (gap_a <= 0.0) {
+          if (!(gap_b <= 0.0) || nearest < 0) return std::nullopt;   // started inside and left
+          face = nearest;
+          best = 0.0;
+        }
+      }
+      const bool from_inside = face >= 0;
+      for (int f = 0; f < g.face_count() && !from_inside; ++f) {
         const double sa = plane_gap(g, r, f, a), sb = plane_gap(g, r, f, b);
         if (sa < -kTol || !(sb < 0.0)) continue;   // a on the plane (to rounding) counts as outside
         const double t = std::max(sa, 0.0) / (sa - sb);
@@ -513,7 +536,7 @@ std::optional<SurfaceEntry> surface_entry(const SurfaceGeometry& g, double r, co
       }
       if (face < 0) return std::nullopt;
       const auto& F = g.face(face);
-      Vec3 q = a + best * (b - a) - r * F.normal;
+      Vec3 q = (from_inside ? b : Vec3(a + best * (b - a))) - r * F.normal;
       for (int pass = 0; pass < 2; ++pass) {
         for (int i = 0; i < F.count; ++i) {
           const Vec3& m = g.edge_normal(F.first + i);

@@ -303,3 +303,37 @@ TEST_CASE("pressed into a concave edge and a concave corner of a mesh", "[traver
     CHECK((fs.normal - (sp - h).normalized()).norm() < 1e-12);
   }
 }
+
+// A path starting inside a convex polyhedron (the body moved onto the finger, or the first tick)
+// takes the face nearest to the HIP, as a box does: SP is the HIP's projection on it. Starting
+// inside and ending outside enters nothing.
+TEST_CASE("a convex polyhedron entered from inside takes the nearest face", "[traversal][surface]") {
+  const double w = 0.04, h = 0.02;
+  const ConvexPolyhedron roof = graspsim::test::wedge(w, h, 0.03);
+  const SurfaceGeometry g(graspsim::test::convex_shape(roof));
+  const Vec3 nL = Vec3(-h, 0.0, w).normalized();
+  const Vec3 on_left(-0.01, 0.0, h - 0.01 * h / w);
+  const Vec3 hip = on_left - 0.002 * nL;
+  const auto e = surface_entry(g, 0.0, hip + Vec3(0.0, 0.001, 0.0), hip);
+  REQUIRE(e);
+  CHECK(e->t == 0.0);
+  CHECK((e->normal - nL).norm() < 1e-12);
+  CHECK((e->point - on_left).norm() < 1e-12);
+  CHECK_FALSE(surface_entry(g, 0.0, hip, on_left + 0.002 * nL));
+}
+
+// A mesh with a degenerate (zero-area) triangle: that face is never entered or held, and the
+// rest works (no NaN). The plate with one extra triangle on three collinear corners.
+TEST_CASE("a degenerate triangle in a mesh is ignored", "[traversal][surface]") {
+  TriangleMesh plate = graspsim::test::voxel_mesh({1, 1, 1}, Vec3(0.1, 0.1, 0.002), Vec3(-0.05, -0.05, -0.001),
+                                                  [](int, int, int) { return true; });
+  plate.triangles.push_back({0, 1, 1});
+  const SurfaceGeometry g(graspsim::test::mesh_shape(plate));
+  const auto e = surface_entry(g, 0.0, Vec3(0.01, 0.01, 0.01), Vec3(0.01, 0.01, -0.01));
+  REQUIRE(e);
+  CHECK(e->point.z() == Approx(0.001).margin(1e-15));
+  SurfaceTrack tr;
+  REQUIRE(surface_track(g, 0.0, e->features, e->point, e->normal, Vec3(0.02, 0.01, -0.005), tr));
+  CHECK(tr.point.allFinite());
+  CHECK(tr.depth == Approx(0.006).margin(1e-15));
+}
