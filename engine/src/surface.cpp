@@ -150,7 +150,7 @@ std::optional<double> convex_entry_t(const Shape& s, double r, const Vec3& a, co
 // ---------------------------------------------------------------------------------------------
 // Polygonal surfaces: the god-object walk.
 
-const Vec3& F_normal(const SurfaceGeometry& g, int f) { return g.face(f).normal; }
+const Vec3& face_normal(const SurfaceGeometry& g, int f) { return g.face(f).normal; }
 
 double plane_gap(const SurfaceGeometry& g, double r, int f, const Vec3& x) {
   const auto& F = g.face(f);
@@ -319,7 +319,7 @@ bool walk(const SurfaceGeometry& g, double r, bool glued, const Vec3& h, Vec3& p
         // Met on one of its edges while moving out past that edge (from a convex edge onto the
         // next face, below the first one's plane extended): not entered.
         bool leaving = false;
-        const Vec3 q = p + t * d - r * F_normal(g, c);
+        const Vec3 q = p + t * d - r * face_normal(g, c);
         for (int j = 0; j < g.face(c).count && !leaving; ++j) {
           const int e = g.face(c).first + j;
           leaving = std::abs(g.edge_normal(e).dot(q - g.corner(e))) <= kTol &&
