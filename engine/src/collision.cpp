@@ -89,6 +89,7 @@ struct CollisionWorld::Impl {
   fcl::DynamicAABBTreeCollisionManagerd broadphase;
   std::shared_ptr<fcl::Capsuled> path_shape;   // the finger path, resized per query
   std::unique_ptr<fcl::CollisionObjectd> path;
+  std::vector<SurfaceGeometry> surfaces;   // same order as the bodies
 };
 
 CollisionWorld::CollisionWorld(const Model& model) : impl_(std::make_unique<Impl>()) {
@@ -97,6 +98,7 @@ CollisionWorld::CollisionWorld(const Model& model) : impl_(std::make_unique<Impl
     impl_->bodies.push_back(std::make_unique<fcl::CollisionObjectd>(detail::fcl_geometry(model.bodies[i].shape)));
     impl_->bodies.back()->setUserData(reinterpret_cast<void*>(static_cast<std::intptr_t>(i + 1)));
     objects.push_back(impl_->bodies.back().get());
+    impl_->surfaces.emplace_back(model.bodies[i].shape);
   }
   impl_->broadphase.registerObjects(objects);
   impl_->broadphase.setup();
@@ -118,6 +120,8 @@ void CollisionWorld::update(const State& state) {
   }
   impl_->broadphase.update();
 }
+
+const SurfaceGeometry& CollisionWorld::surface(int body) const { return impl_->surfaces[body]; }
 
 namespace {
 // Broadphase callback: every body whose box AABB overlaps the path's is a candidate.

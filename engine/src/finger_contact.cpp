@@ -1,6 +1,7 @@
 // The friction cone algorithm of Melder, Harwin & Sharkey, section 2, per finger.
 #include "graspsim/engine/finger_contact.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 namespace graspsim {
@@ -22,6 +23,12 @@ const Material& surface_material(const Model& model, int body) {
   return body >= 0 ? model.bodies[body].material : model.floor.material;
 }
 
+// The circle a GO that slipped this tick lies on: the static one the tick it breaks away,
+// else the kinetic one (see finger_haptic_step).
+double sliding_radius(bool was_slipping, double static_radius, double kinetic_radius) {
+  return was_slipping ? kinetic_radius : static_radius;
+}
+
 }  // namespace
 
 bool stick_slip_step(const Vec3& sp, double static_radius, double kinetic_radius,
@@ -32,13 +39,6 @@ bool stick_slip_step(const Vec3& sp, double static_radius, double kinetic_radius
   if (within && v_rel_t.dot(d) <= 0.0) return false;   // stopped or turned back: stick
   friction_circle_step(sp, kinetic_radius, go);
   return true;
-}
-
-Face pad_face(const Model& model, int finger, int body, int face) {
-  Face f = body >= 0 ? box_face(model.bodies[body].shape.half_extents, face)
-                     : Face{Vec3::UnitZ(), model.floor.height};
-  f.offset += model.fingers[finger].radius;
-  return f;
 }
 
 ContactPair finger_contact_pair(const Model& model, int finger, int body) {
@@ -52,26 +52,28 @@ void finger_haptic_step(const Model& model, const State& state, const CollisionW
                         std::vector<int>& scratch) {
   rec.slip = 0.0;
   bool track = fs.phase != ContactPhase::kFree;
+  // A pad of radius r is a sphere about the HIP: it touches where its centre enters the shape
+  // grown by r (surface.hpp: boxes with square edges, round shapes exactly, polygonal faces
+  // offset by r).
+  const double r = model.fingers[finger].radius;
 
   if (!track) {
     // Free: did the path since the last haptic tick enter a surface? The earliest entry wins;
     // ties go to the lower body index, then to the floor.
     const Vec3 a = fs.has_last_haptic ? fs.hip_at_last_haptic : hip;
     double best_t = kInfinity;
-    // A pad of radius r touches where its centre enters the box grown by r (its rounded edges
-    // and corners taken square: contact there ends at once, as off any face's edge).
-    const double r = model.fingers[finger].radius;
     collision.bodies_touching_segment(a, hip, r, scratch);
     for (int b : scratch) {
       const BodyState& bs = state.bodies[b];
       const Vec3 a_b = bs.rotation.transpose() * (a - bs.position);
       const Vec3 hip_b = bs.rotation.transpose() * (hip - bs.position);
-      const Vec3 grown = model.bodies[b].shape.half_extents + Vec3::Constant(r);
-      if (const auto e = box_entry(grown, a_b, hip_b); e && e->t < best_t) {
+      if (const auto e = surface_entry(collision.surface(b), r, a_b, hip_b); e && e->t < best_t) {
         best_t = e->t;
         fs.body = b;
-        fs.face = e->face;
+        fs.features = e->features;
+        fs.normal = e->normal;
         fs.god_object = e->point;
+        fs.surface_point = e->point;
       }
     }
     const double h = model.floor.height + r;
@@ -81,10 +83,12 @@ void finger_haptic_step(const Model& model, const State& state, const CollisionW
       if (t < best_t) {
         best_t = t;
         fs.body = kFloor;
-        fs.face = 0;
+        fs.features = Features{1, {0, 0, 0}};
+        fs.normal = Vec3::UnitZ();
         fs.god_object = a + t * (hip - a);
         if (a.z() < h) fs.god_object = hip;
         fs.god_object.z() = h;
+        fs.surface_point = fs.god_object;
       }
     }
     track = best_t <= 1.0;
@@ -93,13 +97,25 @@ void finger_haptic_step(const Model& model, const State& state, const CollisionW
 
   if (track) {
     const Frame fr = contact_frame(state, fs.body);
-    const Face face = pad_face(model, finger, fs.body, fs.face);
     const Vec3 hip_c = fr.R.transpose() * (hip - fr.p);   // HIP in the contact frame
-    // Step 1: the surface point SP, the HIP's projection on the entered face, and the depth.
-    const double depth = face.offset - face.normal.dot(hip_c);
-    const bool on_face = fs.body < 0 || within_face(model.bodies[fs.body].shape.half_extents, fs.face, hip_c);
-    if (depth > 0.0 && on_face) {
-      const Vec3 sp = hip_c + depth * face.normal;
+    // Step 1: the surface point SP (the frictionless god-object), the contact normal and the
+    // depth, tracked from the contact's features: on a box the entered face, on other shapes the
+    // walk over the surface (surface.hpp). The floor is the plane z = height + r.
+    SurfaceTrack tr;
+    bool in_contact = false;
+    if (fs.body >= 0) {
+      in_contact = surface_track(collision.surface(fs.body), r, fs.features, fs.surface_point,
+                                 fs.normal, hip_c, tr);
+    } else {
+      tr.depth = model.floor.height + r - hip_c.z();
+      tr.normal = Vec3::UnitZ();
+      tr.point = hip_c + tr.depth * tr.normal;
+      tr.features = fs.features;
+      in_contact = tr.depth > 0.0;
+    }
+    if (in_contact) {
+      const Vec3& sp = tr.point;
+      const double depth = tr.depth;
       // Step 2: friction circle radius = mu * depth: the static coefficient while sticking;
       // while slipping the kinetic one, widened by c v / k for viscous friction c v, so that the
       // sliding force k r is mu_k f_n + c v, v the finger's tangential speed over the surface.
@@ -109,7 +125,7 @@ void finger_haptic_step(const Model& model, const State& state, const CollisionW
       // (whether it sticks again) and by viscous friction, so a sticking one skips it.
       Vec3 v_rel_t = Vec3::Zero();   // m/s, world
       if (was_slipping || pair.viscous > 0.0) {
-        const Vec3 n_w = fr.R * face.normal;
+        const Vec3 n_w = fr.R * tr.normal;
         const Vec3 go_w = fr.R * fs.god_object + fr.p;
         Vec3 v_rel = fs.has_last_haptic
             ? Vec3((hip - fs.hip_at_last_haptic) * static_cast<double>(model.rates.haptic))
@@ -123,10 +139,35 @@ void finger_haptic_step(const Model& model, const State& state, const CollisionW
       const double viscous = pair.viscous * v_rel_t.norm();  // N, while slipping
       const double kinetic_radius = pair.friction(true) * depth + viscous / pair.stiffness;
       // Steps 3 and 4: move the GO onto the circle only when it lies outside (stick_slip_step
-      // says when a slipping finger sticks again).
+      // says when a slipping finger sticks again). The circle is measured along the chord GO-SP;
+      // after a traversal GO and SP may lie on different faces, and a GO moved along the chord
+      // is put back onto the surface by the same walk, from SP (surface_project; a box's GO
+      // stays on its face's plane, unchanged).
       const Vec3 before = fs.god_object;
       const bool slipped = stick_slip_step(sp, pair.mu * depth, kinetic_radius,
                                            fr.R.transpose() * v_rel_t, was_slipping, fs.god_object);
+      if (slipped && fs.body >= 0 && collision.surface(fs.body).shape().kind != ShapeKind::kBox) {
+        // Projecting a GO that the chord put under a convex edge moves it out, which can take
+        // it a little past the circle: the chord point is then scaled towards SP by s, with
+        // |project(SP + s (GO - SP)) - SP| = radius solved by the secant method (a few
+        // rounds), keeping the largest s found inside the circle (s = 0 is SP itself).
+        const SurfaceGeometry& surface = collision.surface(fs.body);
+        const double circle = sliding_radius(was_slipping, pair.mu * depth, kinetic_radius);
+        const Vec3 chord = fs.god_object - sp;
+        const auto off = [&](double s) {
+          return (surface_project(surface, r, tr, sp + s * chord) - sp).norm() - circle;
+        };
+        double s0 = 0.0, f0 = -circle, s1 = 1.0, f1 = off(1.0), inside = f1 <= 1e-12 * circle ? 1.0 : 0.0;
+        for (int round = 0; round < 8 && inside < 1.0 && std::abs(f1) > 1e-12 * circle; ++round) {
+          const double s2 = std::clamp(s1 - f1 * (s1 - s0) / (f1 - f0), 0.0, 1.0);
+          s0 = s1; f0 = f1; s1 = s2; f1 = off(s2);
+          if (f1 <= 1e-12 * circle) inside = std::max(inside, s1);
+        }
+        fs.god_object = surface_project(surface, r, tr, sp + inside * chord);
+      }
+      fs.surface_point = sp;
+      fs.normal = tr.normal;
+      fs.features = tr.features;
       // The tick the finger breaks away, its GO goes onto the static circle (the force peaks at
       // mu_s f_n); from the next tick on it slides on the kinetic one.
       const bool sliding = slipped && was_slipping;
@@ -144,8 +185,9 @@ void finger_haptic_step(const Model& model, const State& state, const CollisionW
       rec.phase = fs.phase;
       rec.body = fs.body;
     } else {
-      // Out through the entered face, or off its edge (the paper's algorithm does not cross
-      // polygon boundaries): the contact ends.
+      // The HIP left the body (the frictionless god-object reached it), or, on a box, left the
+      // entered face over its edge (boxes keep the paper's "no traversal of polygon
+      // boundaries"): the contact ends.
       track = false;
     }
   }
@@ -175,9 +217,8 @@ Vec3 finger_force(const Model& model, const State& state, int finger, const Vec3
     return Vec3::Zero();
   }
   const Frame fr = contact_frame(state, fs.body);
-  const Face face = pad_face(model, finger, fs.body, fs.face);
   const Vec3 go_world = fr.R * fs.god_object + fr.p;
-  const Vec3 n_w = fr.R * face.normal;
+  const Vec3 n_w = fr.R * fs.normal;   // the contact normal at SP at the last haptic tick
   contact_point = go_world - model.fingers[finger].radius * n_w;   // on the surface
   const ContactPair pair = finger_contact_pair(model, finger, fs.body);
   Vec3 force = pair.stiffness * (go_world - hip);

@@ -30,7 +30,7 @@ double axis_inertia(const BodyParams& bp, const BodyState& bs, const Vec3& point
 
 }  // namespace
 
-TwoPointGrasp two_point_grasp(const Model& model, const State& state, int body) {
+TwoPointGrasp two_point_grasp(const Model& /*model*/, const State& state, int body) {
   TwoPointGrasp g;
   int count = 0;
   for (std::size_t f = 0; f < state.fingers.size(); ++f) {
@@ -42,10 +42,10 @@ TwoPointGrasp two_point_grasp(const Model& model, const State& state, int body) 
   if (count != 2) return g;
   const FingerState& first = state.fingers[g.first];
   const FingerState& second = state.fingers[g.second];
-  // A grasp squeezes from opposite sides: two fingers pressing one face (or adjacent ones)
-  // hold nothing between them.
-  const Vec3& h = model.bodies[body].shape.half_extents;
-  if (box_face(h, first.face).normal.dot(box_face(h, second.face).normal) >= 0.0) return g;
+  // A grasp squeezes from opposite sides: two fingers whose contact normals (stored at the last
+  // haptic tick, in the body frame) do not oppose, pressing one face or adjacent ones, hold
+  // nothing between them. Any shape: the normals are the surface's at the surface points.
+  if (first.normal.dot(second.normal) >= 0.0) return g;
   const BodyState& bs = state.bodies[body];
   const Vec3 a = bs.rotation * first.god_object + bs.position;
   const Vec3 b = bs.rotation * second.god_object + bs.position;

@@ -8,6 +8,7 @@
 #include <new>
 
 #include "tests/engine/harness.hpp"
+#include "tests/engine/shapes.hpp"
 
 namespace {
 std::atomic<long> g_allocations{0};
@@ -132,6 +133,66 @@ TEST_CASE("bodies of every shape step without heap allocation after warm-up", "[
   const long before = g_allocations.load();
   for (int n = 0; n < 3000; ++n) sim.step(input, record);
   CHECK(g_allocations.load() - before == 0);
+}
+
+// Finger contact on other shapes: a tessellated sphere (1280 triangles: entry scans, the walk over
+// facets, the friction GO projected back onto the surface while slipping), an analytic sphere
+// and a cylinder, with pads. After warm-up, zero allocations.
+TEST_CASE("finger contact on meshes and round shapes allocates no heap memory", "[schedule][realtime]") {
+  Model m;
+  m.gravity = Vec3::Zero();
+  BodyParams mesh;
+  mesh.name = "mesh";
+  mesh.shape = graspsim::test::mesh_shape(graspsim::test::icosphere(0.05, 3));
+  mesh.mass = 100.0;   // heavy enough to stay under the fingers
+  mesh.inertia = Vec3::Constant(0.1);
+  mesh.material = Material{0.3, kInfinity, kInfinity, 0.2, 1.0};
+  m.bodies.push_back(mesh);
+  BodyParams ball = mesh;
+  ball.name = "ball";
+  ball.shape = Shape{};
+  ball.shape.kind = ShapeKind::kSphere;
+  ball.shape.radius = 0.04;
+  ball.position = Vec3(0.3, 0.0, 0.0);
+  m.bodies.push_back(ball);
+  BodyParams can = ball;
+  can.name = "can";
+  can.shape.kind = ShapeKind::kCylinder;
+  can.shape.half_length = 0.03;
+  can.position = Vec3(-0.3, 0.0, 0.0);
+  m.bodies.push_back(can);
+  for (const char* name : {"a", "b", "c", "d"}) {
+    FingerParams f = graspsim::test::make_finger(name, 400.0, 2.0);
+    f.radius = name[0] == 'a' ? 0.0 : 0.004;
+    m.fingers.push_back(f);
+  }
+  Simulation sim(m);
+  Input input = make_input(m);
+  TickRecord record = make_tick_record(m);
+  const auto step = [&] {
+    const double t = sim.time();
+    const double press = std::min(t, 0.5) * 0.02;   // into each body, then round it
+    const Vec3 round(std::cos(2.0 * t), std::sin(2.0 * t) * 0.6, std::sin(2.0 * t) * 0.8);
+    input.fingers[0].hip = sim.state().bodies[0].position + (0.06 - press) * round;
+    input.fingers[1].hip = Vec3(0.3, 0.0, 0.0) + (0.054 - press) * round;
+    input.fingers[2].hip = Vec3(-0.3, 0.0, 0.0) + (0.05 - press) * round;
+    input.fingers[3].hip = Vec3(0.1 * std::cos(t), 0.1, 0.0);   // free, passing by
+    sim.step(input, record);
+  };
+  for (int n = 0; n < 10; ++n) step();
+  const long before = g_allocations.load();
+  int contacts = 0, slipping = 0;
+  for (int n = 0; n < 3000 * 2; ++n) {
+    step();
+    if (!record.haptic_ran) continue;
+    for (int f = 0; f < 3; ++f) {
+      if (record.haptic[f].phase != ContactPhase::kFree) ++contacts;
+      if (record.haptic[f].phase == ContactPhase::kSlip) ++slipping;
+    }
+  }
+  CHECK(g_allocations.load() - before == 0);
+  CHECK(contacts > 1000);
+  CHECK(slipping > 100);
 }
 
 // Body against body: a box resting on a box (a clipped manifold, four points, friction anchors

@@ -9,6 +9,7 @@
 #include "graspsim/engine/math.hpp"
 #include "graspsim/engine/model.hpp"
 #include "graspsim/engine/state.hpp"
+#include "graspsim/engine/surface.hpp"
 
 namespace graspsim {
 
@@ -55,6 +56,9 @@ class CollisionWorld {
   // `radius` (m), touches, ascending, written into `out` (cleared first; no allocation once its
   // capacity suffices). A superset of the bodies the segment enters: box_entry() decides.
   void bodies_touching_segment(const Vec3& a, const Vec3& b, double radius, std::vector<int>& out) const;
+
+  // Body b's shape with its surface queries' precomputed data (planes, neighbours).
+  const SurfaceGeometry& surface(int body) const;
 
  private:
   struct Impl;

@@ -39,13 +39,9 @@ bool stick_slip_step(const Vec3& sp, double static_radius, double kinetic_radius
 // Contact parameters of finger f on body b (or kFloor): the pad and the surface in series.
 ContactPair finger_contact_pair(const Model& model, int finger, int body);
 
-// The plane the pad centre of finger f is held to on face `face` of body b (or the floor), in
-// the contact frame: the face moved out by the pad's radius (a sphere touching a plane is a
-// point touching the plane offset by its radius).
-Face pad_face(const Model& model, int finger, int body, int face);
-
 // One haptic tick of finger f with the HIP at `hip` (m, world): finds a new contact when the
-// finger is free (the face its path entered), else runs the friction cone on the contacted face.
+// finger is free (the feature its path entered), else tracks the surface point over the surface
+// (surface_track) and runs the friction cone about it.
 // Fills every field of `rec` but `force`, which the servo stage sets (finger_force()).
 // `scratch` holds candidate bodies (kept to avoid allocation).
 void finger_haptic_step(const Model& model, const State& state, const CollisionWorld& collision,
@@ -55,8 +51,8 @@ void finger_haptic_step(const Model& model, const State& state, const CollisionW
 // Force on the finger for the newest HIP: k (GO - HIP) + c (v_GO - v_HIP), with k the pad and
 // surface in series, c the finger's damping, v_GO the velocity of the body point under the GO
 // and v_HIP = (HIP - previous HIP) * servo rate. Zero when free, and zero when it would pull the
-// finger into the face (a contact pushes, never pulls); its tangential part is limited to mu
-// times its normal part (the cone holds at every servo tick). `go_world` receives the GO (m, world).
+// finger into the surface (a contact pushes, never pulls); its tangential part is limited to mu
+// times its normal part, both about the stored contact normal (the cone holds at every servo tick). `go_world` receives the GO (m, world).
 Vec3 finger_force(const Model& model, const State& state, int finger, const Vec3& hip,
                   Vec3& go_world);
 

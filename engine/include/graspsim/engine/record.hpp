@@ -29,8 +29,9 @@ struct ServoFingerRecord {
 
 struct HapticFingerRecord {
   Vec3 god_object{0.0, 0.0, 0.0};      // m, world (= HIP when free)
-  Vec3 surface_point{0.0, 0.0, 0.0};   // m, world: HIP projected on the contacted face (= HIP free)
-  double depth = 0.0;                  // m: penetration of the HIP below the contacted face
+  Vec3 surface_point{0.0, 0.0, 0.0};   // m, world: SP, the frictionless god-object on the contacted
+                                       //    surface (= HIP free); on a face, the HIP's projection
+  double depth = 0.0;                  // m: |SP - HIP|, the HIP's penetration (0 free)
   double friction_radius = 0.0;        // m: mu * depth
   Vec3 force{0.0, 0.0, 0.0};           // N, world: force on the finger (the servo force of this tick)
   ContactPhase phase = ContactPhase::kFree;

@@ -8,6 +8,7 @@
 
 #include "graspsim/engine/math.hpp"
 #include "graspsim/engine/model.hpp"
+#include "graspsim/engine/surface.hpp"
 
 namespace graspsim {
 
@@ -23,7 +24,12 @@ struct FingerState {
   bool has_last_haptic = false;             // false until the first haptic tick
   ContactPhase phase = ContactPhase::kFree;
   int body = kNoBody;                       // index into Model::bodies, kFloor or kNoBody
-  int face = 0;                             // contacted face: box 0..5 = +x,-x,+y,-y,+z,-z; floor 0
+  Features features;                        // the contact's feature / constraint set (surface.hpp:
+                                            //    box face 0..5 = +x,-x,+y,-y,+z,-z; floor 0)
+  Vec3 surface_point{0.0, 0.0, 0.0};        // m: SP, the frictionless god-object, at the last
+                                            //    haptic tick, in the contact frame (the walk's start)
+  Vec3 normal{0.0, 0.0, 1.0};               // 1: contact normal at SP at the last haptic tick, unit,
+                                            //    out of the surface, in the contact frame
   Vec3 god_object{0.0, 0.0, 0.0};           // m: GO in the contacted body's frame (world for the
                                             //    floor), so it rides with the body
   double viscous_force = 0.0;               // N: viscous part of the sliding force at the last
