@@ -61,11 +61,18 @@ void finger_haptic_step(const Model& model, const State& state, const CollisionW
     // Free: did the path since the last haptic tick enter a surface? The earliest entry wins;
     // ties go to the lower body index, then to the floor.
     const Vec3 a = fs.has_last_haptic ? fs.hip_at_last_haptic : hip;
+    // The path is relative to each body: its start in the body's frame as it was at the last
+    // haptic tick (before a physics step since then), its end in the body's frame now. A body
+    // that moved onto a resting finger is then entered through the face that met the finger,
+    // where a path taken in the current frame alone would be a point and enter nothing.
+    const std::int64_t last_haptic = state.tick - model.rates.servo / model.rates.haptic;
     double best_t = kInfinity;
     collision.bodies_touching_segment(a, hip, r, scratch);
     for (int b : scratch) {
       const BodyState& bs = state.bodies[b];
-      const Vec3 a_b = bs.rotation.transpose() * (a - bs.position);
+      const bool moved = fs.has_last_haptic && bs.stepped_at >= last_haptic;
+      const Vec3 a_b = moved ? Vec3(bs.rotation_before_step.transpose() * (a - bs.position_before_step))
+                             : Vec3(bs.rotation.transpose() * (a - bs.position));
       const Vec3 hip_b = bs.rotation.transpose() * (hip - bs.position);
       if (const auto e = surface_entry(collision.surface(b), r, a_b, hip_b); e && e->t < best_t) {
         best_t = e->t;

@@ -123,6 +123,9 @@ void Simulation::step(const Input& input, TickRecord& record) {
       rec.force = force;
       rec.torque = torque;
 
+      bs.position_before_step = bs.position;
+      bs.rotation_before_step = bs.rotation;
+      bs.stepped_at = n;
       integrate_body(bp, model_.gyroscopic, bs, force, torque, dt);
       bs.window_force.setZero();
       bs.window_torque.setZero();

@@ -337,3 +337,46 @@ TEST_CASE("a degenerate triangle in a mesh is ignored", "[traversal][surface]") 
   CHECK(tr.point.allFinite());
   CHECK(tr.depth == Approx(0.006).margin(1e-15));
 }
+
+// A body moving onto a resting finger (the finger's HIP never moves; a box, the same cube as a
+// closed mesh, and as a convex hull, 6 cm, flying at -1 m/s along x in zero gravity, its path
+// passing 2 cm off centre in y). The finger's path since its last haptic tick is taken relative
+// to the body: from the body's frame before the physics step to its frame after it. The finger
+// therefore enters through the -x face, the face the body's motion brought to it, whatever the
+// depth of the first haptic tick inside (up to one physics step of motion, 2 cm at 50 Hz). Taken
+// in the current frame alone the path is a point: the mesh and hull would enter nothing (the
+// ring of handle_lift fell through its finger) and the box would take its nearest face, +y at
+// 1 cm rather than -x at up to 2 cm.
+TEST_CASE("a body moving onto a resting finger is entered through the face that met it", "[finger_contact][law]") {
+  const Vec3 h(0.03, 0.03, 0.03);
+  const TriangleMesh cube = graspsim::test::box_mesh(h);
+  for (const Shape& shape : {box_shape(h), graspsim::mesh_shape(cube), graspsim::convex_shape(cube)}) {
+    for (int physics : {50, 500}) {
+      Model m;
+      m.rates.physics = physics;
+      m.gravity = Vec3::Zero();
+      BodyParams b = graspsim::test::make_box("cube", 0.5, h, Vec3(0.1, -0.02, 0.0), Material{0.5, kInfinity, kInfinity});
+      b.shape = shape;
+      b.velocity = Vec3(-1.0, 0.0, 0.0);
+      m.bodies.push_back(b);
+      m.fingers.push_back(make_finger("finger", 100.0));
+      Simulation sim(m);
+      Input input = make_input(m);   // the HIP stays at the origin
+      TickRecord record = make_tick_record(m);
+      INFO("shape kind " << static_cast<int>(shape.kind) << ", physics " << physics << " Hz");
+      int n = 0;
+      while (sim.state().fingers[0].phase == ContactPhase::kFree && n < 3000) {
+        sim.step(input, record);
+        ++n;
+      }
+      const FingerState& fs = sim.state().fingers[0];
+      REQUIRE(fs.phase != ContactPhase::kFree);
+      CHECK(fs.body == 0);
+      // Entered through -x: the normal in the body frame, and the GO on that face.
+      CHECK(fs.normal.isApprox(Vec3(-1.0, 0.0, 0.0), 1e-12));
+      CHECK(fs.god_object.x() == Approx(-h.x()).margin(1e-12));
+      // It enters within one physics step of the front face reaching the finger (t = 0.07 s).
+      CHECK(sim.time() <= 0.07 + 1.0 / physics + 1e-9);
+    }
+  }
+}

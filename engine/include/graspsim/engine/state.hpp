@@ -80,6 +80,12 @@ struct BodyState {
   Mat3 rotation = Mat3::Identity();       // 1: body to world (R = [n o a])
   Vec3 velocity{0.0, 0.0, 0.0};           // m/s, world
   Vec3 angular_velocity{0.0, 0.0, 0.0};   // rad/s, world
+  // The pose before the last physics step: a free finger's path since its last haptic tick is
+  // taken relative to the body, so a body that moved onto a resting finger is entered through
+  // the face its motion brought to the finger.
+  Vec3 position_before_step{0.0, 0.0, 0.0};       // m, world
+  Mat3 rotation_before_step = Mat3::Identity();   // 1: body to world
+  std::int64_t stepped_at = -1;                   // servo tick of the last physics step (-1: none)
   std::vector<VertexContact> floor_contacts;   // one per floor point of the shape (object_contact.hpp),
                                                // sized by initial_state
   // Finger wrench accumulated over the current physics window (sum over servo ticks).
