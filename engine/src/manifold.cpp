@@ -14,6 +14,26 @@ std::uint64_t combine(std::uint64_t h, std::uint64_t v) {
   return h ^ (v + 0x9e3779b97f4a7c15ULL + (h << 6) + (h >> 2));
 }
 
+// Features of A (owner 0) and B (owner 1): a vertex, an edge (its two vertices, either order)
+// or a face, by index in that body's hull. A clip point is where a feature of A meets one of B;
+// its key combines the two, A's first, so it does not depend on which body gives the reference
+// face: A's vertex v inside B's face f is the same point whether it was kept as a vertex of A's
+// incident face or cut out of B's incident face at the corner v of A's reference face.
+enum : std::uint64_t { kVertex = 1, kEdge = 2, kFace = 3, kSidePlane = 4 };
+
+std::uint64_t feature(std::uint64_t owner, std::uint64_t kind, std::uint64_t i, std::uint64_t j = 0) {
+  return combine(combine(combine(combine(7, owner), kind), i), j);
+}
+
+std::uint64_t edge_feature(std::uint64_t owner, int v, int w) {
+  return feature(owner, kEdge, static_cast<std::uint64_t>(std::min(v, w)), static_cast<std::uint64_t>(std::max(v, w)));
+}
+
+std::uint64_t point_key(std::uint64_t owner_1, std::uint64_t f1, std::uint64_t f2) {
+  // f1 belongs to owner_1, f2 to the other body.
+  return owner_1 == 0 ? combine(combine(5, f1), f2) : combine(combine(5, f2), f1);
+}
+
 struct FaceQuery {
   double separation = -std::numeric_limits<double>::infinity();   // m
   int face = -1;
@@ -178,17 +198,33 @@ int manifold(const HullEdges& ha, const Vec3& xa, const Mat3& ra, const HullEdge
       inc_face = f;
     }
   }
-  const std::uint64_t pair_key = combine(combine(combine(1, flip ? 1 : 0), static_cast<std::uint64_t>(ref_face)),
-                                         static_cast<std::uint64_t>(inc_face));
+  // Keys by the features of A and B that meet (point_key), never by which one is the reference:
+  // a resting box whose two faces are about as deep as each other changes reference as it rocks,
+  // and must keep its friction anchors when it does.
+  const std::uint64_t own_ref = flip ? 1 : 0, own_inc = flip ? 0 : 1;
+  const std::uint64_t ref_face_feature = feature(own_ref, kFace, static_cast<std::uint64_t>(ref_face));
+  const std::uint64_t inc_face_feature = feature(own_inc, kFace, static_cast<std::uint64_t>(inc_face));
+  const std::vector<int>& iv = inc.faces[inc_face].vertices;
   s.polygon.clear();
-  for (int v : inc.faces[inc_face].vertices) s.polygon.push_back({winc[v], static_cast<std::uint64_t>(v) + 1});
+  for (std::size_t i = 0; i < iv.size(); ++i) {
+    const int v = iv[i], w = iv[(i + 1) % iv.size()];
+    s.polygon.push_back({winc[v], point_key(own_inc, feature(own_inc, kVertex, static_cast<std::uint64_t>(v)), ref_face_feature),
+                         edge_feature(own_inc, v, w)});
+  }
 
   // Sutherland-Hodgman against each side plane of the reference face: the plane through edge
   // i (v_i -> v_i+1, counter-clockwise about n) with outward normal e x n; keep the inner side.
+  // A crossing of the polygon's edge p -> q with side plane i is where that edge meets the
+  // reference face's edge i: an incident edge there (two edges meet), or, when p -> q was cut
+  // along side plane j before, the reference face's corner between edges j and i (its vertex in
+  // the incident face). The polygon's edge after an exit crossing runs along plane i.
   const int m = static_cast<int>(rf.vertices.size());
   for (int i = 0; i < m && !s.polygon.empty(); ++i) {
-    const Vec3& p0 = wref[rf.vertices[i]];
-    const Vec3 side = (wref[rf.vertices[(i + 1) % m]] - p0).cross(n);
+    const int r0 = rf.vertices[i], r1 = rf.vertices[(i + 1) % m];
+    const Vec3& p0 = wref[r0];
+    const Vec3 side = (wref[r1] - p0).cross(n);
+    const std::uint64_t ref_edge = edge_feature(own_ref, r0, r1);
+    const std::uint64_t plane = feature(own_ref, kSidePlane, static_cast<std::uint64_t>(i));
     s.clipped.clear();
     const int count = static_cast<int>(s.polygon.size());
     for (int k = 0; k < count; ++k) {
@@ -198,8 +234,15 @@ int manifold(const HullEdges& ha, const Vec3& xa, const Mat3& ra, const HullEdge
       if (dp <= 0.0) s.clipped.push_back(p);
       if ((dp <= 0.0) != (dq <= 0.0)) {   // the edge p -> q crosses the plane: add the crossing
         const double t = dp / (dp - dq);
-        s.clipped.push_back({p.x + t * (q.x - p.x),
-                             combine(combine(combine(2, p.key), q.key), static_cast<std::uint64_t>(i))});
+        std::uint64_t key = point_key(own_inc, p.edge, ref_edge);
+        for (int j = 0; j < m; ++j) {   // p -> q lies along side plane j: the corner of j and i
+          if (p.edge != feature(own_ref, kSidePlane, static_cast<std::uint64_t>(j))) continue;
+          const int shared = j == (i + m - 1) % m ? r0 : (j == (i + 1) % m ? r1 : -1);
+          key = shared >= 0 ? point_key(own_ref, feature(own_ref, kVertex, static_cast<std::uint64_t>(shared)), inc_face_feature)
+                            : combine(combine(6, p.edge), plane);   // not a corner: clipped later
+          break;
+        }
+        s.clipped.push_back({p.x + t * (q.x - p.x), key, dp <= 0.0 ? plane : p.edge});
       }
     }
     std::swap(s.polygon, s.clipped);
@@ -215,7 +258,7 @@ int manifold(const HullEdges& ha, const Vec3& xa, const Mat3& ra, const HullEdge
     point.point = p.x + 0.5 * depth * n;
     point.normal = flip ? Vec3(-n) : n;
     point.depth = depth;
-    point.key = combine(pair_key, p.key);
+    point.key = p.key;
     if (found < capacity) {
       out[found++] = point;
       continue;

@@ -130,3 +130,58 @@ TEST_CASE("a 100:1 stack rests at 3000 Hz and is flagged at 50 Hz", "[stack][law
   for (const auto& w : warnings) named = named || w.find("'bottom' and 'top'") != std::string::npos;
   CHECK(named);
 }
+
+
+// The friction spring of a box on a box is k times the stretch of its anchors, whichever body's
+// face the manifold takes as reference. An 8 cm box (A) stands 1 mm deep on a 12 x 12 x 8 cm base
+// (B, k per point); it is moved 0.2 mm along x (4 points stuck: F_t = 4 k s on each body), then
+// tilted about the centre of its bottom face. At 0.5 mrad A's face is the reference (the contact
+// normal is A's, tilted); at 5 mrad B's face is clearly less deep (depth_B < 0.98 depth_A) and
+// becomes the reference (the normal is exactly B's). F_t stays 4 k s at every step of a wobble
+// back and forth, but for three small terms: on A's face the normal force, turned by a, adds
+// 4 k d a along x (d a / s = 0.25% of F_t); the anchors are material points d / 2 inside A, so
+// turning A by 4.5 mrad about its bottom face moves them by (d / 2) 4.5 mrad = 1.1% of s; the
+// corners move by x (1 - cos a) <= 5e-7 m, 0.25% of s. Within 1.6% (1.1% measured), 2% checked.
+// The keys used to name the clip points by the reference face and its side planes, so every
+// change of reference dropped all four anchors and the stretch with them (F_t = 0): a box rocking
+// on a base walked off it a stretch at a time.
+TEST_CASE("a box's friction stretch on a box survives a change of reference face", "[stack][manifold][law]") {
+  const double k = 500.0, d = 0.001, s = 0.0002;
+  Model m;
+  m.rates.physics = 500;
+  m.gravity = Vec3::Zero();
+  const Vec3 ha(0.04, 0.04, 0.04), hb(0.06, 0.06, 0.04);
+  m.bodies.push_back(make_box("A", 0.4, ha, Vec3(0.0, 0.0, hb.z() + ha.z() - d), Material{0.8, kInfinity, kInfinity}));
+  m.bodies.push_back(make_box("B", 0.4, hb, Vec3::Zero(), Material{0.8, k, 1.0}));
+  State state = initial_state(m);
+  BodyContacts contacts(m);
+  std::vector<Wrench> wrenches(2);
+  std::vector<int> points(2);
+  const Vec3 base_centre(0.0, 0.0, hb.z() - d);   // A's bottom-face centre, m
+  const auto pose = [&](double shift, double tilt) {
+    const Mat3 r = Eigen::AngleAxisd(tilt, Vec3::UnitY()).toRotationMatrix();
+    state.bodies[0].rotation = r;
+    state.bodies[0].position = base_centre + Vec3(shift, 0.0, 0.0) + r * Vec3(0.0, 0.0, ha.z());
+  };
+  const auto step = [&] {
+    wrenches.assign(2, Wrench{});
+    points.assign(2, 0);
+    contacts.step(m, state, wrenches, points);
+  };
+  pose(0.0, 0.0005);
+  step();   // anchors where A stands
+  ManifoldPoint mp[kMaxPairPoints];
+  for (int wobble = 0; wobble < 3; ++wobble) {
+    for (double tilt : {0.0005, 0.005}) {
+      pose(s, tilt);
+      REQUIRE(contacts.points(m, state, 0, 1, mp) == 4);
+      const bool b_reference = mp[0].normal.x() == 0.0;
+      CHECK(b_reference == (tilt > 0.001));   // the reference face did change
+      step();
+      INFO("wobble " << wobble << ", tilt " << tilt << " rad: F_t " << wrenches[1].force.x() << " N");
+      CHECK(points[0] == 4);
+      CHECK(wrenches[1].force.x() == Approx(4.0 * k * s).epsilon(0.02));
+      CHECK(wrenches[0].force.x() == Approx(-4.0 * k * s).epsilon(0.02));
+    }
+  }
+}

@@ -18,7 +18,9 @@ struct ManifoldPoint {
   Vec3 point{0.0, 0.0, 0.0};    // m, world: midway between the two surfaces
   Vec3 normal{0.0, 0.0, 1.0};   // 1, world, unit: from A towards B (the force on B is along it)
   double depth = 0.0;           // m: > 0, overlap along the normal
-  std::uint64_t key = 0;        // feature id: the same features give the same key at every step
+  std::uint64_t key = 0;        // feature id: the same features give the same key at every step,
+                                // whichever body's face is the reference (a feature of A and one of
+                                // B: A's vertex in B's face, B's vertex in A's face, or two edges)
 };
 
 // A convex polyhedron with its edges listed once (a < b), for the edge-edge axes.
@@ -35,6 +37,8 @@ struct ManifoldScratch {
   struct ClipVertex {
     Vec3 x;               // m, world
     std::uint64_t key;    // feature id of the point
+    std::uint64_t edge;   // feature id of the polygon's edge from this vertex to the next: an
+                          // incident edge, or a reference side plane the polygon was cut along
   };
   std::vector<Vec3> world_a, world_b;          // m: vertices of A and B in world
   std::vector<ClipVertex> polygon, clipped;    // Sutherland-Hodgman buffers
@@ -47,7 +51,8 @@ inline constexpr int kMaxManifoldPoints = 16;
 // when more than `capacity` were found (ties by key), else in clipping order. Returns the count
 // written to `out` (0 when separated). A face contact's reference face is the face (of A or B)
 // with the least penetration, A preferred unless B's is clearly less (Box2D's 0.98 relative
-// tolerance, so that the choice does not flicker on a resting stack); an edge-edge contact gives
+// tolerance, so that the choice seldom flickers on a resting stack; when it does, the points'
+// keys, which name features of A and B and not the reference, stay); an edge-edge contact gives
 // one point, at the middle of the two edges' closest points, used only when its axis separates
 // clearly more than any face axis and the closest points lie within both edges. Only edge pairs
 // that form a face of the Minkowski difference are tested (Gregorius' Gauss-map test): an edge
