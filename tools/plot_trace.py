@@ -366,7 +366,15 @@ def plot(traces, args, np, plt):
         ax_band.set_yticks([])
         empty(ax_band, "no fingers in this trace")
 
+    # Forces and distances are never negative: their axes start at 0, so a constant force reads
+    # as its value and not as an offset rounding error.
+    for ax in (ax_fn, ax_ft, ax_go):
+        lo, hi = ax.get_ylim()
+        if fingers and lo > -0.05 * hi:
+            ax.set_ylim(-0.04 * max(hi, 1e-9), 1.08 * hi)
     for ax in axes:
+        if ax is not ax_band:
+            ax.ticklabel_format(axis="y", useOffset=False)
         ax.grid(True, color="0.9", lw=0.6)
         ax.set_xlim(t0, t1)
         if ax is not axes[-1]:
@@ -495,6 +503,9 @@ def main(argv=None):
         try:
             with os.fdopen(fd, "wb") as fh:
                 fig.savefig(fh, format="png", dpi=100)
+            umask = os.umask(0)
+            os.umask(umask)
+            os.chmod(tmp, 0o666 & ~umask)   # mkstemp's file is private; an image need not be
             os.replace(tmp, out)
         except OSError as e:
             os.unlink(tmp)
