@@ -11,6 +11,7 @@ graspsim_packages=(
   g++ make cmake pkg-config git
   libeigen3-dev libfcl-dev liblua5.4-dev libhdf5-dev catch2
   hdf5-tools
+  python3-h5py python3-matplotlib
 )
 
 graspsim_install_missing() {
