@@ -12,6 +12,8 @@ graspsim_packages=(
   libeigen3-dev libfcl-dev liblua5.4-dev libhdf5-dev catch2
   hdf5-tools
 )
+# h5py (Debian's /usr/bin/python3) opens traces cut by a crash in SWMR mode: tests/e2e/test_crash.cpp.
+graspsim_packages+=(python3-h5py)
 
 graspsim_install_missing() {
   local missing=() p
