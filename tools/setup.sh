@@ -13,6 +13,8 @@ graspsim_packages=(
   hdf5-tools
   python3-h5py python3-matplotlib
 )
+# h5py (Debian's /usr/bin/python3) opens traces cut by a crash in SWMR mode: tests/e2e/test_crash.cpp.
+graspsim_packages+=(python3-h5py)
 
 graspsim_install_missing() {
   local missing=() p

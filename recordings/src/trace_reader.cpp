@@ -13,7 +13,14 @@ h5::Handle open_file(const std::string& file) {
   const htri_t is_hdf5 = H5Fis_hdf5(file.c_str());
   if (is_hdf5 < 0) throw TraceError(where + ": " + h5::last_error());
   if (is_hdf5 == 0) throw TraceError(where + ": not an HDF5 file");
-  return h5::checked(H5Fopen(file.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), H5Fclose, where);
+  const hid_t plain = H5Fopen(file.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  if (plain >= 0) return h5::Handle(plain, H5Fclose);
+  // A trace still being written, or cut by a crash, is marked as open for SWMR writing: it
+  // opens as a SWMR reader (recordings/README.md, "Crash safety").
+  const std::string reason = h5::last_error();
+  const hid_t swmr = H5Fopen(file.c_str(), H5F_ACC_RDONLY | H5F_ACC_SWMR_READ, H5P_DEFAULT);
+  if (swmr >= 0) return h5::Handle(swmr, H5Fclose);
+  throw TraceError(where + ": " + reason);
 }
 
 // Follows `path` one link at a time, so a missing intermediate group gives false, not an error.
@@ -54,7 +61,10 @@ DType dtype_of(hid_t type, const std::string& context) {
     if (size == 4) return DType::kInt32;
     if (size == 1) return DType::kInt8;
   }
-  throw TraceError(context + ": element type is not float64, int64, int32 or int8");
+  if (type_class == H5T_INTEGER && H5Tget_sign(type) == H5T_SGN_NONE && size == 8) {
+    return DType::kUInt64;
+  }
+  throw TraceError(context + ": element type is not float64, int64, int32, int8 or uint64");
 }
 
 }  // namespace
@@ -80,7 +90,13 @@ Dataset read_dataset(const std::string& file, const std::string& path) {
     count *= static_cast<std::size_t>(d);
   }
   out.values.resize(count);
-  if (count > 0) {
+  if (count > 0 && out.dtype == DType::kUInt64) {
+    out.bits.resize(count);
+    h5::check(H5Dread(object.get(), H5T_NATIVE_UINT64, H5S_ALL, H5S_ALL, H5P_DEFAULT,
+                      out.bits.data()),
+              context + ": cannot read");
+    for (std::size_t i = 0; i < count; ++i) out.values[i] = static_cast<double>(out.bits[i]);
+  } else if (count > 0) {
     h5::check(H5Dread(object.get(), H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT,
                       out.values.data()),
               context + ": cannot read");

@@ -5,6 +5,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "graspsim/engine/state_hash.hpp"
+
 namespace graspsim::recordings {
 namespace {
 
@@ -40,6 +42,10 @@ TraceRecorder::TraceRecorder(TraceWriter& writer, const graspsim::Model& model)
   servo_time_ = time_columns(servo_);
   haptic_time_ = time_columns(haptic_);
   physics_time_ = time_columns(physics_);
+  state_hash_ = physics_.add_column("state_hash", 1, DType::kUInt64, "1");
+  physics_.set_attribute("state_hash", "hash",
+                         "FNV-1a 64 of the engine State after this tick's step "
+                         "(graspsim::state_hash, engine/README.md)");
 
   for (const auto& finger : model.fingers) {
     const std::string p = "fingers/" + finger.name + "/";
@@ -47,6 +53,8 @@ TraceRecorder::TraceRecorder(TraceWriter& writer, const graspsim::Model& model)
     s.hip = servo_.add_column(p + "hip", 3, DType::kFloat64, "m");
     s.force = servo_.add_column(p + "force", 3, DType::kFloat64, "N");
     s.force_demand = servo_.add_column(p + "force_demand", 3, DType::kFloat64, "N");
+    s.gimbal = servo_.add_column(p + "gimbal", 3, DType::kFloat64, "rad");
+    servo_.set_attribute(p + "gimbal", "order", "roll, pitch, yaw");
     servo_fingers_.push_back(s);
 
     HapticColumns h{};
@@ -88,9 +96,11 @@ TraceRecorder::TraceRecorder(TraceWriter& writer, const graspsim::Model& model)
 }
 
 void TraceRecorder::record(const graspsim::TickRecord& rec,
-                           const std::vector<graspsim::Vec3>& rendered) {
+                           const std::vector<graspsim::Vec3>& rendered,
+                           const graspsim::Input& input, const graspsim::State& after) {
   const std::size_t fingers = servo_fingers_.size();
   if (rec.servo.size() != fingers || rendered.size() != fingers ||
+      input.fingers.size() != fingers ||
       (rec.haptic_ran && rec.haptic.size() != fingers) ||
       (rec.physics_ran && rec.physics.size() != objects_.size())) {
     throw std::invalid_argument("TraceRecorder::record: record sizes do not match the model");
@@ -106,6 +116,7 @@ void TraceRecorder::record(const graspsim::TickRecord& rec,
     put(row, c.hip, rec.servo[i].hip);
     put(row, c.force, rendered[i]);
     put(row, c.force_demand, rec.servo[i].force);
+    put(row, c.gimbal, input.fingers[i].gimbal);
   }
 
   if (rec.haptic_ran) {
@@ -130,6 +141,7 @@ void TraceRecorder::record(const graspsim::TickRecord& rec,
     row = physics_.append_row();
     row[physics_time_.tick] = tick;
     row[physics_time_.time] = time;
+    row[state_hash_] = uint64_in_row(state_hash(after));
     for (std::size_t k = 0; k < objects_.size(); ++k) {
       const PhysicsColumns& c = objects_[k];
       const BodyRecord& b = rec.physics[k];

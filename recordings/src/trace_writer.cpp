@@ -3,7 +3,9 @@
 #include "graspsim/recordings/trace_writer.hpp"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
+#include <functional>
 #include <map>
 #include <sstream>
 #include <type_traits>
@@ -33,6 +35,7 @@ hid_t file_type_of(DType dtype) {
     case DType::kInt64: return H5T_STD_I64LE;
     case DType::kInt32: return H5T_STD_I32LE;
     case DType::kInt8: return H5T_STD_I8LE;
+    case DType::kUInt64: return H5T_STD_U64LE;
   }
   return H5T_IEEE_F64LE;
 }
@@ -43,6 +46,7 @@ const char* name_of(DType dtype) {
     case DType::kInt64: return "int64";
     case DType::kInt32: return "int32";
     case DType::kInt8: return "int8";
+    case DType::kUInt64: return "uint64";
   }
   return "?";
 }
@@ -54,7 +58,7 @@ double lowest(DType dtype) {
     case DType::kInt64: return -9223372036854775808.0;   // -2^63
     case DType::kInt32: return -2147483648.0;
     case DType::kInt8: return -128.0;
-    case DType::kFloat64: break;
+    case DType::kFloat64: case DType::kUInt64: break;
   }
   return 0.0;
 }
@@ -64,7 +68,7 @@ double highest(DType dtype) {
     case DType::kInt64: return 9223372036854775808.0;    // 2^63, exclusive
     case DType::kInt32: return 2147483647.0;
     case DType::kInt8: return 127.0;
-    case DType::kFloat64: break;
+    case DType::kFloat64: case DType::kUInt64: break;
   }
   return 0.0;
 }
@@ -85,6 +89,37 @@ struct Column {
   h5::Handle dataset;
 };
 
+// What the writer and its tables share about the file: whether its layout is frozen (the first
+// row was appended) and SWMR writing started.
+struct FileState {
+  hid_t file = H5I_INVALID_HID;   // not owned (TraceWriter::Impl::file)
+  std::string context;            // "trace 'PATH'"
+  bool swmr = true;               // TraceOptions::swmr
+  bool frozen = false;            // a row was appended: no new table, column or table attribute
+
+  void freeze() {
+    if (frozen) return;
+    if (swmr && H5Fstart_swmr_write(file) < 0) {
+      throw TraceError(context + ": cannot start SWMR writing: " + h5::last_error());
+    }
+    frozen = true;
+  }
+};
+
+// Object creation properties without modification times, so that two runs write the same
+// object headers.
+h5::Handle untimed(hid_t property_class, const std::string& where) {
+  h5::Handle plist = h5::checked(H5Pcreate(property_class), H5Pclose, where);
+  h5::check(H5Pset_obj_track_times(plist.get(), 0), where);
+  return plist;
+}
+
+h5::Handle file_access(bool swmr, const std::string& where) {
+  h5::Handle fapl = h5::checked(H5Pcreate(H5P_FILE_ACCESS), H5Pclose, where);
+  if (swmr) h5::check(H5Pset_libver_bounds(fapl.get(), H5F_LIBVER_LATEST, H5F_LIBVER_LATEST), where);
+  return fapl;
+}
+
 }  // namespace
 
 // ---------------------------------------------------------------------------------------------
@@ -94,6 +129,7 @@ struct TraceTable::Impl {
   std::string file_path;
   std::string group_path;   // "/servo"
   TraceOptions options;
+  FileState* file = nullptr;     // owned by the writer
   h5::Handle group;
   std::vector<Column> columns;
   std::size_t row_width = 0;     // doubles per row
@@ -104,6 +140,7 @@ struct TraceTable::Impl {
   std::vector<std::int64_t> scratch_i64;
   std::vector<std::int32_t> scratch_i32;
   std::vector<std::int8_t> scratch_i8;
+  std::vector<std::uint64_t> scratch_u64;
   std::size_t buffered = 0;      // rows in `buffer`
   std::int64_t rows = 0;         // rows appended
   std::int64_t written = 0;      // rows on disk
@@ -129,9 +166,9 @@ std::size_t TraceTable::add_column(const std::string& path, int width, DType dty
   Impl& t = *impl_;
   t.require_open();
   const std::string full = t.group_path + "/" + path;
-  if (t.started) {
+  if (t.started || t.file->frozen) {
     throw TraceError(t.context(full) + ": add_column after the first row of " +
-                     quoted(t.group_path));
+                     quoted(t.group_path) + " or of the file");
   }
   if (!is_relative_path(path)) {
     throw TraceError(t.context(full) + ": column path must be relative, like 'fingers/a/hip'");
@@ -150,7 +187,7 @@ std::size_t TraceTable::add_column(const std::string& path, int width, DType dty
   const hsize_t chunk[2] = {static_cast<hsize_t>(t.options.block_rows),
                             static_cast<hsize_t>(width)};
   h5::Handle space = h5::checked(H5Screate_simple(rank, dims, max_dims), H5Sclose, where);
-  h5::Handle dcpl = h5::checked(H5Pcreate(H5P_DATASET_CREATE), H5Pclose, where);
+  h5::Handle dcpl = untimed(H5P_DATASET_CREATE, where);
   h5::check(H5Pset_chunk(dcpl.get(), rank, chunk), where);
   if (t.options.compression > 0) {
     h5::check(H5Pset_deflate(dcpl.get(), static_cast<unsigned>(t.options.compression)), where);
@@ -176,12 +213,15 @@ double* TraceTable::append_row() {
     // Everything the table will ever need, allocated once.
     const std::size_t block = t.options.block_rows;
     t.buffer.assign(block * t.row_width, 0.0);
-    std::size_t need[4] = {0, 0, 0, 0};
+    std::size_t need[5] = {0, 0, 0, 0, 0};
     for (const Column& c : t.columns) need[static_cast<int>(c.dtype)] = block * t.max_width;
     t.scratch_f64.assign(need[static_cast<int>(DType::kFloat64)], 0.0);
     t.scratch_i64.assign(need[static_cast<int>(DType::kInt64)], 0);
     t.scratch_i32.assign(need[static_cast<int>(DType::kInt32)], 0);
     t.scratch_i8.assign(need[static_cast<int>(DType::kInt8)], 0);
+    t.scratch_u64.assign(need[static_cast<int>(DType::kUInt64)], 0);
+    h5::Quiet quiet;
+    t.file->freeze();
     t.started = true;
   }
   if (t.buffered == t.options.block_rows) {
@@ -214,6 +254,9 @@ void TraceTable::set_attribute(const std::string& dataset_or_dot, const std::str
   t.require_open();
   const std::string full =
       dataset_or_dot == "." ? t.group_path : t.group_path + "/" + dataset_or_dot;
+  if (t.file->frozen) {
+    throw TraceError(t.context(full) + ": attribute '" + name + "' after the file's first row");
+  }
   if (dataset_or_dot != "." && !is_relative_path(dataset_or_dot)) {
     throw TraceError(t.context(full) + ": not a path relative to " + quoted(t.group_path));
   }
@@ -248,6 +291,11 @@ void TraceTable::Impl::write_column(Column& column) {
       const double* src = buffer.data() + r * row_width + column.offset;
       for (std::size_t c = 0; c < width; ++c) {
         const double value = src[c];
+        if (column.dtype == DType::kUInt64) {   // raw bits, see uint64_in_row
+          out[r * width + c] = static_cast<std::remove_reference_t<decltype(out[0])>>(
+              std::bit_cast<std::uint64_t>(value));
+          continue;
+        }
         if (column.dtype != DType::kFloat64 && !fits(value, column.dtype)) {
           std::ostringstream message;
           message.precision(17);
@@ -265,6 +313,7 @@ void TraceTable::Impl::write_column(Column& column) {
     case DType::kInt64: gather(scratch_i64); memory_type = H5T_NATIVE_INT64; break;
     case DType::kInt32: gather(scratch_i32); memory_type = H5T_NATIVE_INT32; break;
     case DType::kInt8: gather(scratch_i8); memory_type = H5T_NATIVE_INT8; break;
+    case DType::kUInt64: gather(scratch_u64); memory_type = H5T_NATIVE_UINT64; break;
   }
 
   // Grow the dataset and write the block into its new rows.
@@ -294,6 +343,9 @@ struct TraceWriter::Impl {
   TraceOptions options;
   h5::Handle file;
   h5::Handle root;
+  FileState state;
+  // Root attributes set after the first row, written by close() (name, writer), in call order.
+  std::vector<std::pair<std::string, std::function<void(hid_t)>>> pending;
   // Ordered by name, so flush order (and the file's layout) does not depend on first use.
   std::map<std::string, std::unique_ptr<TraceTable>> tables;
   bool closed = false;
@@ -302,6 +354,7 @@ struct TraceWriter::Impl {
   void require_open() const {
     if (closed) throw TraceError(context() + ": used after close");
   }
+  void set_root_attribute(const std::string& name, std::function<void(hid_t)> write);
 };
 
 TraceWriter::TraceWriter(const std::string& path, TraceOptions options)
@@ -314,8 +367,12 @@ TraceWriter::TraceWriter(const std::string& path, TraceOptions options)
     throw TraceError(where + ": compression must be 0 (none) or a deflate level 1..9");
   }
   h5::Quiet quiet;
-  impl_->file = h5::checked(H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT),
+  h5::Handle fapl = file_access(options.swmr, where);
+  impl_->file = h5::checked(H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, fapl.get()),
                             H5Fclose, where);
+  impl_->state.file = impl_->file.get();
+  impl_->state.context = impl_->context();
+  impl_->state.swmr = options.swmr;
   impl_->root = h5::checked(H5Gopen2(impl_->file.get(), "/", H5P_DEFAULT), H5Gclose, where);
   h5::write_string_attribute(impl_->root.get(), "status", "running", where);
   h5::check(H5Fflush(impl_->file.get(), H5F_SCOPE_LOCAL), where);
@@ -337,39 +394,55 @@ TraceTable& TraceWriter::table(const std::string& group) {
   if (!is_relative_path(name)) {
     throw TraceError(w.context() + ": bad table name " + quoted(group));
   }
+  if (w.state.frozen) {
+    throw TraceError(w.context() + ": table " + quoted(group) + " created after the file's first row");
+  }
   h5::Quiet quiet;
   const std::string where = w.context() + ": cannot create group " + quoted("/" + name);
   h5::Handle lcpl = h5::checked(H5Pcreate(H5P_LINK_CREATE), H5Pclose, where);
   h5::check(H5Pset_create_intermediate_group(lcpl.get(), 1), where);
+  h5::Handle gcpl = untimed(H5P_GROUP_CREATE, where);
   auto impl = std::make_unique<TraceTable::Impl>();
+  impl->file = &w.state;
   impl->file_path = w.path;
   impl->group_path = "/" + name;
   impl->options = w.options;
   impl->group = h5::checked(
-      H5Gcreate2(w.root.get(), name.c_str(), lcpl.get(), H5P_DEFAULT, H5P_DEFAULT), H5Gclose,
+      H5Gcreate2(w.root.get(), name.c_str(), lcpl.get(), gcpl.get(), H5P_DEFAULT), H5Gclose,
       where);
   auto table = std::unique_ptr<TraceTable>(new TraceTable(std::move(impl)));
   return *w.tables.emplace(name, std::move(table)).first->second;
 }
 
+void TraceWriter::Impl::set_root_attribute(const std::string& name,
+                                           std::function<void(hid_t)> write) {
+  require_open();
+  if (!state.frozen) {
+    h5::Quiet quiet;
+    write(root.get());
+    return;
+  }
+  // SWMR cannot add attributes: keep it (replacing one of the same name) for close().
+  std::erase_if(pending, [&name](const auto& p) { return p.first == name; });
+  pending.emplace_back(name, std::move(write));
+}
+
 void TraceWriter::set_attribute(const std::string& name, const std::string& value) {
-  impl_->require_open();
-  h5::Quiet quiet;
-  h5::write_string_attribute(impl_->root.get(), name, value, impl_->context());
+  impl_->set_root_attribute(name, [name, value, context = impl_->context()](hid_t root) {
+    h5::write_string_attribute(root, name, value, context);
+  });
 }
 
 void TraceWriter::set_attribute(const std::string& name, double value) {
-  impl_->require_open();
-  h5::Quiet quiet;
-  h5::write_scalar_attribute(impl_->root.get(), name, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, &value,
-                             impl_->context());
+  impl_->set_root_attribute(name, [name, value, context = impl_->context()](hid_t root) {
+    h5::write_scalar_attribute(root, name, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, &value, context);
+  });
 }
 
 void TraceWriter::set_attribute(const std::string& name, std::int64_t value) {
-  impl_->require_open();
-  h5::Quiet quiet;
-  h5::write_scalar_attribute(impl_->root.get(), name, H5T_STD_I64LE, H5T_NATIVE_INT64, &value,
-                             impl_->context());
+  impl_->set_root_attribute(name, [name, value, context = impl_->context()](hid_t root) {
+    h5::write_scalar_attribute(root, name, H5T_STD_I64LE, H5T_NATIVE_INT64, &value, context);
+  });
 }
 
 void TraceWriter::flush() {
@@ -392,13 +465,8 @@ void TraceWriter::close(const std::string& status) {
       if (failure.empty()) failure = e.what();
     }
   }
-  try {
-    h5::write_string_attribute(w.root.get(), "status",
-                               failure.empty() ? status : "error: " + failure, w.context());
-  } catch (const TraceError& e) {
-    if (failure.empty()) failure = e.what();
-  }
-  // Every object of the file is closed before the file itself, so H5Fclose really closes it.
+  // Every object of the file is closed before the file itself, so H5Fclose really closes it
+  // (and ends SWMR writing, clearing the superblock's status flags).
   for (auto& [name, table] : w.tables) {
     table->impl_->closed = true;
     for (Column& column : table->impl_->columns) column.dataset.reset();
@@ -408,6 +476,27 @@ void TraceWriter::close(const std::string& status) {
   if (w.file.close() < 0 && failure.empty()) {
     failure = w.context() + ": cannot close: " + h5::last_error();
   }
+  // Reopened without SWMR for what SWMR cannot write: the kept attributes and the status.
+  try {
+    const std::string where = w.context() + ": cannot reopen to write the status";
+    h5::Handle fapl = file_access(w.options.swmr, where);
+    h5::Handle file = h5::checked(H5Fopen(w.path.c_str(), H5F_ACC_RDWR, fapl.get()), H5Fclose, where);
+    h5::Handle root = h5::checked(H5Gopen2(file.get(), "/", H5P_DEFAULT), H5Gclose, where);
+    for (const auto& [name, write] : w.pending) {
+      try {
+        write(root.get());
+      } catch (const TraceError& e) {
+        if (failure.empty()) failure = e.what();
+      }
+    }
+    h5::write_string_attribute(root.get(), "status",
+                               failure.empty() ? status : "error: " + failure, w.context());
+    root.reset();
+    if (file.close() < 0) throw TraceError(w.context() + ": cannot close: " + h5::last_error());
+  } catch (const TraceError& e) {
+    if (failure.empty()) failure = e.what();
+  }
+  w.pending.clear();
   if (!failure.empty()) throw TraceError(failure);
 }
 

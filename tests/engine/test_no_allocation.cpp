@@ -7,6 +7,7 @@
 #include <cstdlib>
 #include <new>
 
+#include "graspsim/engine/state_hash.hpp"
 #include "tests/engine/harness.hpp"
 #include "tests/engine/shapes.hpp"
 
@@ -45,9 +46,11 @@ TEST_CASE("a simulation step allocates no heap memory after warm-up", "[schedule
   };
   Input input = make_input(m);
   TickRecord record = make_tick_record(m);
+  std::uint64_t hashes = 0;   // the run loop hashes the State after every physics tick
   const auto step = [&] {
     for (std::size_t i = 0; i < 2; ++i) input.fingers[i].hip = hips(i, sim.time());
     sim.step(input, record);
+    if (record.physics_ran) hashes ^= state_hash(sim.state());
   };
   for (int n = 0; n < 10; ++n) step();
   const long before = g_allocations.load();
@@ -59,6 +62,7 @@ TEST_CASE("a simulation step allocates no heap memory after warm-up", "[schedule
   const long during = g_allocations.load() - before;
   CHECK(during == 0);
   CHECK(contacts > 100);   // both regimes were visited
+  CHECK(hashes != 0);
 }
 
 // The same with every option on: implicit gyroscopic term (3x3 LU), two-finger torsion by gravity

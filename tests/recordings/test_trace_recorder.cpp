@@ -14,6 +14,7 @@
 
 #include "graspsim/engine/model.hpp"
 #include "graspsim/engine/record.hpp"
+#include "graspsim/engine/state_hash.hpp"
 #include "graspsim/recordings/trace_reader.hpp"
 #include "graspsim/recordings/trace_recorder.hpp"
 
@@ -111,6 +112,18 @@ void fill(TickRecord& rec, std::vector<Vec3>& rendered, std::int64_t tick) {
   b.twist = v(tick, 0, 6, 2);
 }
 
+// The device input of tick `tick` (the gimbal angles are traced) and the State after it (only
+// its hash is traced): a state whose tick and first body position follow the tick.
+void fill_input(Input& input, std::int64_t tick) {
+  for (int i = 0; i < 2; ++i) input.fingers[static_cast<std::size_t>(i)].gimbal = v3(tick, i, 9);
+}
+void fill_state(State& state, std::int64_t tick) {
+  state.tick = tick + 1;
+  state.bodies[0].position = v3(tick, 0, 7);
+}
+Input blank_input() { return make_input(small_model()); }
+State blank_state() { return initial_state(small_model()); }
+
 TickRecord blank_record() {
   TickRecord rec;
   rec.servo.resize(2);
@@ -163,10 +176,14 @@ TEST_CASE("the recorder writes the schema with exact values at each loop's rate"
     TraceWriter writer(file, TraceOptions{7, 0});
     TraceRecorder recorder(writer, model);
     TickRecord rec = blank_record();
+    Input input = blank_input();
+    State state = blank_state();
     std::vector<Vec3> rendered(2);
     for (std::int64_t tick = 0; tick < 60; ++tick) {
       fill(rec, rendered, tick);
-      recorder.record(rec, rendered);
+      fill_input(input, tick);
+      fill_state(state, tick);
+      recorder.record(rec, rendered, input, state);
     }
     writer.close("complete");
   }
@@ -197,6 +214,8 @@ TEST_CASE("the recorder writes the schema with exact values at each loop's rate"
     check(file, s + "force_demand", {ns, 3}, DType::kFloat64, "N",
           column(servo_ticks, 3, field(1)));
     check(file, s + "force", {ns, 3}, DType::kFloat64, "N", column(servo_ticks, 3, field(2)));
+    check(file, s + "gimbal", {ns, 3}, DType::kFloat64, "rad", column(servo_ticks, 3, field(9)));
+    CHECK(read_string_attribute(file, s + "gimbal", "order") == "roll, pitch, yaw");
 
     const std::string h = "/haptic/fingers/" + names[i] + "/";
     auto scalar = [i](int f) { return [i, f](std::int64_t t, int) { return v(t, i, f, 0); }; };
@@ -218,6 +237,21 @@ TEST_CASE("the recorder writes the schema with exact values at each loop's rate"
           "-1 none, -2 floor, k = objects[k]");
   }
   CHECK(read_string_attribute(file, "/haptic", "bodies") == "box");
+
+  // The state hash of each physics tick, exact to the bit (uint64, not rounded through double).
+  {
+    const Dataset hashes = read_dataset(file, "/physics/state_hash");
+    CHECK(hashes.dtype == DType::kUInt64);
+    CHECK(hashes.shape == std::vector<std::size_t>{np});
+    CHECK(hashes.units == "1");
+    std::vector<std::uint64_t> expected;
+    State state = blank_state();
+    for (std::int64_t t : physics_ticks) {
+      fill_state(state, t);
+      expected.push_back(state_hash(state));
+    }
+    CHECK(hashes.bits == expected);
+  }
 
   const std::string o = "/physics/objects/box/";
   auto body = [](int f) { return [f](std::int64_t t, int c) { return v(t, 0, f, c); }; };
@@ -267,13 +301,17 @@ TEST_CASE("record allocates nothing after the first row, block writes included",
   TraceWriter writer(file, TraceOptions{8, 0});
   TraceRecorder recorder(writer, small_model());
   TickRecord rec = blank_record();
+  Input input = blank_input();
+  State state = blank_state();
   std::vector<Vec3> rendered(2);
   fill(rec, rendered, 0);   // haptic and physics both run on tick 0
-  recorder.record(rec, rendered);
+  recorder.record(rec, rendered, input, state);
   const long before = g_allocations.load();
   for (std::int64_t tick = 1; tick < 300; ++tick) {   // 37 servo, 7 haptic, 3 physics blocks
     fill(rec, rendered, tick);
-    recorder.record(rec, rendered);
+    fill_input(input, tick);
+    fill_state(state, tick);
+    recorder.record(rec, rendered, input, state);
   }
   const long allocations = g_allocations.load() - before;
   CHECK(allocations == 0);
@@ -293,11 +331,16 @@ TEST_CASE("the recorder refuses unusable names and mismatched records", "[trace_
   TraceWriter writer(file);
   TraceRecorder recorder(writer, small_model());
   TickRecord rec = blank_record();
+  Input input = blank_input();
+  const State state = blank_state();
   std::vector<Vec3> rendered(1);
-  CHECK_THROWS_AS(recorder.record(rec, rendered), std::invalid_argument);
+  CHECK_THROWS_AS(recorder.record(rec, rendered, input, state), std::invalid_argument);
   rendered.resize(2);
+  input.fingers.resize(1);
+  CHECK_THROWS_AS(recorder.record(rec, rendered, input, state), std::invalid_argument);
+  input.fingers.resize(2);
   rec.physics_ran = true;
   rec.physics.clear();
-  CHECK_THROWS_AS(recorder.record(rec, rendered), std::invalid_argument);
+  CHECK_THROWS_AS(recorder.record(rec, rendered, input, state), std::invalid_argument);
   writer.close("complete");
 }

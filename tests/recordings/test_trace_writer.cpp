@@ -372,10 +372,12 @@ TEST_CASE("compressed traces round-trip exactly and are deflated", "[trace_write
   const std::string packed = tmp_path("deflate.h5");
   for (const auto& [file, level] : {std::pair{plain, 0}, std::pair{packed, 6}}) {
     TraceWriter writer(file, TraceOptions{64, level});
+    // Every table is declared before the first row (the layout freezes then, for SWMR).
     TraceTable& t = writer.table("mixed");
-    fill_mixed(t, declare_mixed(t), 150);
+    const MixedColumns columns = declare_mixed(t);
     TraceTable& r = writer.table("repetitive");
     r.add_column("z", 3, DType::kFloat64, "m");
+    fill_mixed(t, columns, 150);
     for (int i = 0; i < 4000; ++i) {
       double* row = r.append_row();
       row[0] = row[1] = row[2] = 0.25;

@@ -4,12 +4,15 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cinttypes>
 #include <cmath>
+#include <cstdio>
 #include <memory>
 #include <optional>
 #include <sstream>
 
 #include "graspsim/engine/simulation.hpp"
+#include "graspsim/engine/state_hash.hpp"
 #include "graspsim/hw/scripted_finger.hpp"
 #include "graspsim/recordings/trace_recorder.hpp"
 #include "graspsim/recordings/trace_writer.hpp"
@@ -77,6 +80,30 @@ std::string join_lines(const std::vector<std::string>& lines) {
   return out;
 }
 
+// "fnv1a64:" and 16 lower-case hex digits of the FNV-1a 64 hash of the text's bytes.
+std::string source_hash(const std::string& text) {
+  char hex[17];
+  std::snprintf(hex, sizeof hex, "%016" PRIx64, fnv1a64(text.data(), text.size()));
+  return std::string("fnv1a64:") + hex;
+}
+
+// Root attributes go to the trace if there is one (no trace: the benchmark's baseline).
+struct OptionalWriter {
+  recordings::TraceWriter* w;
+  template <typename T>
+  void set_attribute(const std::string& name, const T& value) {
+    if (w) w->set_attribute(name, value);
+  }
+};
+
+// Crash safety (recordings/README.md): the trace is flushed at least every kFlushSimulated
+// seconds of simulated time and at least every kFlushWall seconds of wall time, so a run killed
+// at any moment loses at most that much. The wall clock is read every kWallCheckTicks ticks;
+// it decides only when rows reach the disk, never what is written.
+constexpr double kFlushSimulated = 0.25;   // s, simulated
+constexpr double kFlushWall = 0.9;         // s, wall (under 1 s, with the check interval's slack)
+constexpr std::int64_t kWallCheckTicks = 64;
+
 }  // namespace
 
 bool RunResult::passed() const {
@@ -92,13 +119,19 @@ RunResult run_scenario(const scripting::Scenario& scenario, const RunOptions& op
   recordings::TraceOptions trace_options;
   trace_options.block_rows = options.block_rows;
   trace_options.compression = options.compression;
-  recordings::TraceWriter writer(result.trace_path, trace_options);   // throws if it cannot
+  // Without a trace (the logging benchmark's baseline) every attribute and row is skipped.
+  std::optional<recordings::TraceWriter> writer_holder;
+  if (options.write_trace) writer_holder.emplace(result.trace_path, trace_options);   // throws if it cannot
+  else result.trace_path.clear();
+  OptionalWriter writer{writer_holder ? &*writer_holder : nullptr};
 
   // The file explains and replays itself: the scenario text, every parameter, rates, seed, build.
-  writer.set_attribute("schema_version", std::int64_t{1});
+  writer.set_attribute("schema_version", std::int64_t{2});
   writer.set_attribute("scenario_path", scenario.path());
   writer.set_attribute("scenario_name", scenario.name());
   writer.set_attribute("scenario_source", scenario.source());
+  writer.set_attribute("scenario_source_hash", source_hash(scenario.source()));
+  writer.set_attribute("overrides", join_lines(options.overrides));
   writer.set_attribute("parameters", join_lines(scenario.parameters()));
   writer.set_attribute("rate_servo", std::int64_t{model.rates.servo});
   writer.set_attribute("rate_haptic", std::int64_t{model.rates.haptic});
@@ -132,7 +165,8 @@ RunResult run_scenario(const scripting::Scenario& scenario, const RunOptions& op
     writer.set_attribute("devices", device_list.str());
 
     Simulation& sim = sim_holder.emplace(model);
-    recordings::TraceRecorder recorder(writer, model);
+    std::optional<recordings::TraceRecorder> recorder;
+    if (writer_holder) recorder.emplace(*writer_holder, model);
     Input input = make_input(model);
     TickRecord record = make_tick_record(model);
     std::vector<Vec3> rendered(model.fingers.size(), Vec3::Zero());
@@ -168,6 +202,9 @@ RunResult run_scenario(const scripting::Scenario& scenario, const RunOptions& op
     };
 
     auto last_progress = start;
+    auto last_flush = start;
+    const std::int64_t flush_ticks =
+        std::max<std::int64_t>(1, static_cast<std::int64_t>(std::floor(kFlushSimulated * model.rates.servo)));
     for (std::int64_t n = 0; n < ticks; ++n) {
       const double t = sim.time();
       for (std::size_t f = 0; f < devices.size(); ++f) {
@@ -183,7 +220,14 @@ RunResult run_scenario(const scripting::Scenario& scenario, const RunOptions& op
       check_due(n);
       sim.step(input, record);
       for (std::size_t f = 0; f < devices.size(); ++f) rendered[f] = devices[f]->render(record.servo[f].force);
-      recorder.record(record, rendered);
+      if (recorder) {
+        recorder->record(record, rendered, input, sim.state());
+        if ((n + 1) % flush_ticks == 0 ||
+            (n % kWallCheckTicks == 0 && seconds_since(last_flush) >= kFlushWall)) {
+          writer_holder->flush();
+          last_flush = Clock::now();
+        }
+      }
       ++result.servo_ticks;
       if (record.diverged_body >= 0) {
         const BodyState& bs = sim.state().bodies[record.diverged_body];
@@ -233,7 +277,7 @@ RunResult run_scenario(const scripting::Scenario& scenario, const RunOptions& op
   }
   try {
     writer.set_attribute("expectations", summary.str());
-    writer.close(result.error.empty() ? "complete" : "error: " + result.error);
+    if (writer_holder) writer_holder->close(result.error.empty() ? "complete" : "error: " + result.error);
   } catch (const std::exception& e) {
     if (result.error.empty()) result.error = std::string("writing the trace: ") + e.what();
   }

@@ -21,6 +21,10 @@ struct RunOptions {
   // (s); may be empty.
   std::function<void(double simulated, double duration)> progress;
   const std::atomic<bool>* interrupt = nullptr;   // set (by a signal handler) to stop the run
+  // The --set overrides as given (NAME=VALUE, "duration=S" for --duration), for the trace's
+  // `overrides` attribute: with the scenario source they reload the same scenario (replay).
+  std::vector<std::string> overrides;
+  bool write_trace = true;   // false: no trace at all (the logging benchmark's baseline)
 };
 
 struct RunResult {

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "app/run.hpp"
+#include "cli/repair.hpp"
 #include "graspsim_version.hpp"
 #include "graspsim/recordings/trace_writer.hpp"
 #include "graspsim/scripting/scenario.hpp"
@@ -27,6 +28,7 @@ constexpr int kExitInterrupted = 130; // Ctrl-C (128 + SIGINT)
 
 constexpr const char* kUsage =
     "usage: graspsim run SCENARIO.lua [--out FILE.h5] [--duration S] [--set NAME=VALUE]...\n"
+    "       graspsim repair TRACE.h5\n"
     "       graspsim --help | --version\n";
 
 constexpr const char* kHelp =
@@ -52,7 +54,10 @@ constexpr const char* kHelp =
     "\n"
     "exit status: 0 every expectation held, 1 an expectation failed, 2 bad input (arguments,\n"
     "scenario, output path, or an error in the script while it ran), 130 interrupted.\n"
-    "A run that stops early keeps its trace, with root attribute status = \"error: ...\".\n";
+    "A run that stops early keeps its trace, with root attribute status = \"error: ...\".\n"
+    "A run killed outright leaves status \"running\" and every tick up to its last flush\n"
+    "(at most 0.25 s simulated or 1 s wall old): h5py opens it with swmr=True; after\n"
+    "`graspsim repair TRACE.h5` (see `graspsim repair --help`) every HDF5 tool does.\n";
 
 std::atomic<bool> g_interrupt{false};
 extern "C" void on_sigint(int) { g_interrupt.store(true); }
@@ -133,6 +138,7 @@ int run_command(const std::vector<std::string>& args) {
   graspsim::app::RunOptions options;
   options.out = out;
   options.compression = compression;
+  options.overrides = load.sets;
   options.interrupt = &g_interrupt;
   const bool tty = isatty(STDERR_FILENO) && !quiet;
   if (tty) {
@@ -206,5 +212,6 @@ int main(int argc, char** argv) {
     return kExitOk;
   }
   if (command == "run") return run_command({args.begin() + 1, args.end()});
+  if (command == "repair") return graspsim::cli::repair_command({args.begin() + 1, args.end()});
   return bad_input("unknown command '" + command + "'\n" + kUsage + "Try 'graspsim --help'.");
 }

@@ -12,13 +12,16 @@
 namespace graspsim::recordings {
 
 struct Dataset {
-  std::vector<double> values;       // row-major, converted to double (integers exact to 2^53)
+  std::vector<double> values;       // row-major, converted to double (integers exact to 2^53;
+                                    //   uint64 rounded to the nearest double)
+  std::vector<std::uint64_t> bits;  // uint64 datasets only (a hash): the exact values, row-major
   std::vector<std::size_t> shape;   // (n,) or (n, width)
   std::string units;                // the "units" attribute, "" if there is none
   DType dtype = DType::kFloat64;    // on-disk type
 };
 
-// Reads a whole dataset ("/servo/time"). Throws TraceError naming the file and the path if the
+// Reads a whole dataset ("/servo/time"). A trace still being written or cut by a crash (marked
+// for SWMR writing) is opened as a SWMR reader. Throws TraceError naming the file and the path if the
 // file is not an HDF5 file, the path is missing or not a dataset, or its type is not one of DType.
 Dataset read_dataset(const std::string& file, const std::string& path);
 // Attribute `name` of the group or dataset `object_path` ("/" for the root).

@@ -3,11 +3,13 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <vector>
 
 #include "graspsim/engine/math.hpp"
 #include "graspsim/engine/model.hpp"
 #include "graspsim/engine/record.hpp"
+#include "graspsim/engine/state.hpp"
 #include "graspsim/recordings/trace_writer.hpp"
 
 namespace graspsim::recordings {
@@ -21,16 +23,21 @@ class TraceRecorder {
 
   // Appends one /servo row, plus a /haptic row if rec.haptic_ran and a /physics row if
   // rec.physics_ran. `rendered` (one per finger): the force each device actually rendered after
-  // clamping (N, world). time = tick / servo rate, computed from the tick, never accumulated.
-  // Allocates nothing (after each table's first row). Throws std::invalid_argument if a record
-  // vector does not match the model's finger or body count.
-  void record(const graspsim::TickRecord& rec, const std::vector<graspsim::Vec3>& rendered);
+  // clamping (N, world). `input`: the device input the step was given (its gimbal angles go to
+  // /servo, so the trace alone can replay the run). `after`: the State after the step, whose
+  // state_hash goes to /physics/state_hash. time = tick / servo rate, computed from the tick,
+  // never accumulated. Allocates nothing (after each table's first row). Throws
+  // std::invalid_argument if a record or input vector does not match the model's finger or
+  // body count.
+  void record(const graspsim::TickRecord& rec, const std::vector<graspsim::Vec3>& rendered,
+              const graspsim::Input& input, const graspsim::State& after);
 
  private:
   struct ServoColumns {
     std::size_t hip;            // offset of fingers/<name>/hip
     std::size_t force;          // offset of fingers/<name>/force
     std::size_t force_demand;   // offset of fingers/<name>/force_demand
+    std::size_t gimbal;         // offset of fingers/<name>/gimbal
   };
   struct HapticColumns {
     std::size_t god_object, surface_point, depth, friction_radius, force, state, body, slip;
@@ -51,6 +58,7 @@ class TraceRecorder {
   TimeColumns servo_time_;
   TimeColumns haptic_time_;
   TimeColumns physics_time_;
+  std::size_t state_hash_;                      // offset of /physics/state_hash
   std::vector<ServoColumns> servo_fingers_;     // Model::fingers order
   std::vector<HapticColumns> haptic_fingers_;   // Model::fingers order
   std::vector<PhysicsColumns> objects_;         // Model::bodies order

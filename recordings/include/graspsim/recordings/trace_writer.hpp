@@ -2,6 +2,7 @@
 // grow one row at a time together, buffered in blocks and appended to chunked datasets.
 #pragma once
 
+#include <bit>
 #include <concepts>
 #include <cstddef>
 #include <cstdint>
@@ -18,8 +19,13 @@ class TraceError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-// On-disk element type of a dataset (little-endian IEEE double or signed integers).
-enum class DType { kFloat64, kInt64, kInt32, kInt8 };
+// On-disk element type of a dataset (little-endian IEEE double, signed integers, or uint64).
+// kUInt64 carries 64 raw bits (a hash) through the row: put them there with uint64_in_row().
+enum class DType { kFloat64, kInt64, kInt32, kInt8, kUInt64 };
+
+// The row value of a kUInt64 column: the 64 bits of `value` carried in a double, unchanged
+// (written back bit for bit; never do arithmetic on it).
+inline double uint64_in_row(std::uint64_t value) { return std::bit_cast<double>(value); }
 
 // A group of datasets that grow together: one append_row() adds one row to every dataset of
 // the group at once, so they can never drift apart (the H5MD lesson). Owned by a TraceWriter.
@@ -33,8 +39,8 @@ class TraceTable {
   // "fingers/thumb/hip"; intermediate groups are created) with `width` values per row: width 1
   // gives shape (n,), width > 1 gives (n, width). Stored as `dtype`, with string attribute
   // "units" = units. The dataset is created at once with 0 rows. Returns the column's offset
-  // into a row. Only allowed before the first row; throws TraceError after it, for a bad path,
-  // a path used twice, or width < 1.
+  // into a row. Only allowed before the first row of any table of the file (the layout is then
+  // frozen for SWMR); throws TraceError after it, for a bad path, a path used twice, or width < 1.
   std::size_t add_column(const std::string& path, int width, DType dtype,
                          const std::string& units);
   // Pointer to the next row: row_width() doubles in column order; the caller fills all of them.
@@ -42,12 +48,14 @@ class TraceTable {
   // converted on flush (exact up to 2^53); a value that is not an integer in the column's range
   // makes the flush throw TraceError naming the dataset and row. Writes the buffered block when
   // it is full (then also flushes the file's metadata, so a run cut short leaves a readable
-  // file). Allocates only on the first call.
+  // file). The first row of any table freezes the file's layout and, with TraceOptions::swmr,
+  // starts SWMR writing. Allocates only on the first call.
   double* append_row();
   std::size_t row_width() const;   // doubles per row
   std::int64_t rows() const;       // rows appended so far (flushed or not)
   void flush();                    // writes buffered rows (no-op if none)
   // String attribute on a dataset or group below this table's group; "." = the group itself.
+  // Only before the file's first row (throws TraceError after it).
   void set_attribute(const std::string& dataset_or_dot, const std::string& name,
                      const std::string& value);
 
@@ -61,6 +69,10 @@ class TraceTable {
 struct TraceOptions {
   std::size_t block_rows = 1024;   // rows: buffered per table before a write; also the chunk size
   int compression = 0;             // 0 = none, 1..9 = deflate level
+  // Crash safety (recordings/README.md): the newest file format and SWMR writing from the first
+  // row on, so a process killed at any moment leaves every flushed row readable. false: the
+  // default (oldest compatible) format, no SWMR.
+  bool swmr = true;
 };
 
 class TraceWriter {
@@ -76,9 +88,11 @@ class TraceWriter {
   TraceWriter& operator=(const TraceWriter&) = delete;
 
   // The table of group `group` ("servo" or "/servo"; may be nested, "a/b"), created on first
-  // use; the same object afterwards. References stay valid until the writer is destroyed.
+  // use (only before the file's first row); the same object afterwards. References stay valid
+  // until the writer is destroyed.
   TraceTable& table(const std::string& group);
-  // Root attributes (replacing one of the same name).
+  // Root attributes (replacing one of the same name). Before the file's first row they are
+  // written at once; after it (SWMR cannot add attributes) they are kept and written by close().
   void set_attribute(const std::string& name, const std::string& value);
   void set_attribute(const std::string& name, double value);
   void set_attribute(const std::string& name, std::int64_t value);
@@ -90,8 +104,8 @@ class TraceWriter {
     set_attribute(name, static_cast<std::int64_t>(value));
   }
   void flush();   // every table, then H5Fflush
-  // Flushes, writes root string attribute "status" (e.g. "complete" or "error: <message>")
-  // and closes the file. Idempotent: later calls do nothing. If the flush fails the status
+  // Flushes, closes the file, reopens it without SWMR, writes the kept root attributes and
+  // root string attribute "status" (e.g. "complete" or "error: <message>") and closes it. Idempotent: later calls do nothing. If the flush fails the status
   // written is "error: <flush failure>", the file is still closed, and TraceError is thrown.
   void close(const std::string& status);
   bool is_closed() const;

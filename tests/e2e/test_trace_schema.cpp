@@ -1,0 +1,230 @@
+// The schema document matches what is written: every dataset and attribute of a real trace is
+// in recordings/README.md's tables (same shape, dtype, units, type), and everything the tables
+// list is in the trace. Parses the README; fails when the two disagree, naming the difference.
+#include <catch2/catch.hpp>
+#include <hdf5.h>
+
+#include <fstream>
+#include <set>
+#include <sstream>
+#include <string>
+#include <tuple>
+#include <vector>
+
+#include "app/run.hpp"
+#include "graspsim/scripting/scenario.hpp"
+
+using namespace graspsim;
+
+namespace {
+
+const std::string kReadme = std::string(GRASPSIM_SOURCE_DIR) + "/recordings/README.md";
+const std::string kScenario = std::string(GRASPSIM_SOURCE_DIR) + "/scenarios/two_finger_lift.lua";
+const std::string kTmp = GRASPSIM_TEST_TMP;
+
+using DatasetRow = std::tuple<std::string, std::string, std::string, std::string>;   // path, shape, dtype, units
+using AttributeRow = std::tuple<std::string, std::string, std::string>;              // on, name, type
+
+std::string trim(const std::string& s) {
+  const auto a = s.find_first_not_of(" \t");
+  if (a == std::string::npos) return "";
+  return s.substr(a, s.find_last_not_of(" \t") + 1 - a);
+}
+
+// The cells of a markdown table row "| a | b |" (outer pipes dropped).
+std::vector<std::string> cells(const std::string& line) {
+  std::vector<std::string> out;
+  std::stringstream in(line.substr(1));
+  std::string cell;
+  while (std::getline(in, cell, '|')) out.push_back(trim(cell));
+  return out;
+}
+
+// The text between the first pair of backticks ("`/servo` (every tick)" -> "/servo").
+std::string code(const std::string& cell) {
+  const auto a = cell.find('`');
+  if (a == std::string::npos) return cell;
+  const auto b = cell.find('`', a + 1);
+  return cell.substr(a + 1, b - a - 1);
+}
+
+// The rows of the table whose header starts with `header`.
+std::vector<std::vector<std::string>> table(const std::string& header) {
+  std::ifstream in(kReadme);
+  REQUIRE(in);
+  std::vector<std::vector<std::string>> rows;
+  std::string line;
+  bool inside = false;
+  while (std::getline(in, line)) {
+    if (!inside) {
+      inside = line.rfind(header, 0) == 0;
+      continue;
+    }
+    if (line.rfind("|", 0) != 0) break;
+    if (line.rfind("|---", 0) == 0) continue;
+    rows.push_back(cells(line));
+  }
+  REQUIRE(!rows.empty());
+  return rows;
+}
+
+// A file path with finger and object names replaced by the README's placeholders.
+std::string generic(const std::string& path) {
+  std::vector<std::string> parts;
+  std::stringstream in(path);
+  std::string part;
+  while (std::getline(in, part, '/')) parts.push_back(part);
+  std::string out;
+  for (std::size_t i = 1; i < parts.size(); ++i) {
+    std::string p = parts[i];
+    if (i >= 2 && parts[i - 1] == "fingers") p = "<finger>";
+    if (i >= 2 && parts[i - 1] == "objects") p = "<object>";
+    out += "/" + p;
+  }
+  return out.empty() ? "/" : out;
+}
+
+std::string type_name(hid_t type) {
+  const H5T_class_t c = H5Tget_class(type);
+  const std::size_t size = H5Tget_size(type);
+  if (c == H5T_STRING) return "string";
+  if (c == H5T_FLOAT) return "float" + std::to_string(8 * size);
+  if (c == H5T_INTEGER) return (H5Tget_sign(type) == H5T_SGN_NONE ? "uint" : "int") + std::to_string(8 * size);
+  return "?";
+}
+
+struct Found {
+  hid_t file;
+  std::set<DatasetRow> datasets;
+  std::set<AttributeRow> attributes;
+  std::vector<std::string> units_missing;   // datasets without a units attribute
+  std::string current;                      // object whose attributes are being listed
+  bool current_is_dataset = false;
+};
+
+std::string string_attribute(hid_t attribute) {
+  hid_t type = H5Aget_type(attribute);
+  hid_t memory = H5Tcopy(H5T_C_S1);
+  H5Tset_size(memory, H5T_VARIABLE);
+  H5Tset_cset(memory, H5Tget_cset(type));
+  char* text = nullptr;
+  std::string value;
+  if (H5Tis_variable_str(type) > 0 && H5Aread(attribute, memory, &text) >= 0 && text) {
+    value = text;
+    H5free_memory(text);
+  }
+  H5Tclose(memory);
+  H5Tclose(type);
+  return value;
+}
+
+herr_t on_attribute(hid_t object, const char* name, const H5A_info_t*, void* data) {
+  Found& f = *static_cast<Found*>(data);
+  hid_t attribute = H5Aopen(object, name, H5P_DEFAULT);
+  hid_t type = H5Aget_type(attribute);
+  const std::string type_str = type_name(type);
+  H5Tclose(type);
+  if (f.current_is_dataset && std::string(name) == "units") {
+    f.attributes.insert({"every dataset", "units", type_str});
+  } else {
+    f.attributes.insert({generic(f.current), name, type_str});
+  }
+  H5Aclose(attribute);
+  return 0;
+}
+
+herr_t on_object(hid_t root, const char* name, const H5O_info_t* info, void* data) {
+  Found& f = *static_cast<Found*>(data);
+  std::string path = "/";
+  if (std::string(name) != ".") path += name;
+  hid_t object = H5Oopen(root, name, H5P_DEFAULT);
+  f.current = path;
+  f.current_is_dataset = info->type == H5O_TYPE_DATASET;
+  if (f.current_is_dataset) {
+    hid_t space = H5Dget_space(object);
+    hsize_t dims[2] = {0, 0};
+    const int rank = H5Sget_simple_extent_dims(space, dims, nullptr);
+    H5Sclose(space);
+    hid_t type = H5Dget_type(object);
+    std::string units = "(none)";
+    if (H5Aexists(object, "units") > 0) {
+      hid_t a = H5Aopen(object, "units", H5P_DEFAULT);
+      units = string_attribute(a);
+      H5Aclose(a);
+    } else {
+      f.units_missing.push_back(path);
+    }
+    f.datasets.insert({generic(path), rank == 1 ? "(n)" : "(n," + std::to_string(dims[1]) + ")",
+                       type_name(type), units});
+    H5Tclose(type);
+  }
+  H5Aiterate2(object, H5_INDEX_NAME, H5_ITER_INC, nullptr, on_attribute, &f);
+  H5Oclose(object);
+  return 0;
+}
+
+template <typename T>
+std::string list(const std::set<T>& rows) {
+  std::ostringstream out;
+  for (const T& r : rows) {
+    std::apply([&out](const auto&... x) { ((out << x << " | "), ...); }, r);
+    out << "\n";
+  }
+  return out.str();
+}
+
+template <typename T>
+std::set<T> minus(const std::set<T>& a, const std::set<T>& b) {
+  std::set<T> out;
+  for (const T& x : a)
+    if (!b.count(x)) out.insert(x);
+  return out;
+}
+
+}  // namespace
+
+TEST_CASE("recordings/README.md documents exactly the datasets and attributes of a real trace",
+          "[e2e][trace][schema]") {
+  // A real trace of the two-finger lift (4 s, 0.3 s of wall time), with an override.
+  scripting::LoadOptions load;
+  load.sets.push_back("mu=0.8");
+  const auto scenario = scripting::Scenario::load(kScenario, load);
+  app::RunOptions options;
+  options.out = kTmp + "/e2e_schema.h5";
+  options.overrides = load.sets;
+  const app::RunResult result = app::run_scenario(scenario, options);
+  REQUIRE(result.error.empty());
+
+  // The README's tables.
+  std::set<DatasetRow> documented;
+  std::string group;
+  for (const auto& row : table("| group | dataset |")) {
+    REQUIRE(row.size() >= 5);
+    if (!row[0].empty()) group = code(row[0]);
+    documented.insert({group + "/" + code(row[1]), row[2], row[3], row[4]});
+  }
+  std::set<AttributeRow> documented_attributes;
+  for (const auto& row : table("| on | attribute |")) {
+    REQUIRE(row.size() >= 3);
+    const std::string on = row[0].find('`') == std::string::npos ? row[0] : code(row[0]);
+    documented_attributes.insert({on, code(row[1]), row[2]});
+  }
+
+  // The file's datasets and attributes, every object visited.
+  Found found;
+  found.file = H5Fopen(options.out.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  REQUIRE(found.file >= 0);
+  H5Ovisit2(found.file, H5_INDEX_NAME, H5_ITER_INC, on_object, &found, H5O_INFO_BASIC);
+  H5Fclose(found.file);
+
+  INFO("in the trace, not in the README (path | shape | dtype | units):\n" << list(minus(found.datasets, documented)));
+  INFO("in the README, not in the trace:\n" << list(minus(documented, found.datasets)));
+  CHECK(found.datasets == documented);
+  CHECK(found.units_missing.empty());
+  INFO("attributes in the trace, not in the README (on | name | type):\n"
+       << list(minus(found.attributes, documented_attributes)));
+  INFO("attributes in the README, not in the trace:\n" << list(minus(documented_attributes, found.attributes)));
+  CHECK(found.attributes == documented_attributes);
+  // The table's schema_version is the file's.
+  CHECK(documented_attributes.count({"/", "schema_version", "int64"}) == 1);
+}
