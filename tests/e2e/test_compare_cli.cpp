@@ -1,0 +1,267 @@
+// `graspsim compare` as a user meets it, on real traces of the two-finger lift: identical runs
+// compare equal bit for bit, a 1e-9 m change written into one trace with the HDF5 C API is
+// found at its tick, time, object and component (exit 1), tolerances decide, --json is valid
+// JSON, and every kind of unusable input exits 2 with a message naming the file or dataset.
+#include <catch2/catch.hpp>
+#include <hdf5.h>
+
+#include <cctype>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <sys/wait.h>
+
+namespace {
+
+const std::string kCli = GRASPSIM_CLI;
+const std::string kSource = GRASPSIM_SOURCE_DIR;
+const std::string kTmp = GRASPSIM_TEST_TMP;
+
+struct Outcome {
+  int status;           // exit status
+  std::string output;   // stdout (and stderr unless split)
+};
+
+Outcome cli(const std::string& args, bool with_stderr = true) {
+  const std::string command = kCli + " " + args + (with_stderr ? " 2>&1" : " 2>/dev/null");
+  FILE* pipe = popen(command.c_str(), "r");
+  REQUIRE(pipe);
+  std::string out;
+  char buf[4096];
+  while (std::size_t n = std::fread(buf, 1, sizeof buf, pipe)) out.append(buf, n);
+  const int raw = pclose(pipe);
+  return Outcome{WIFEXITED(raw) ? WEXITSTATUS(raw) : -1, out};
+}
+
+// Runs the two-finger lift (4 s) into `out`, with extra arguments.
+void run_lift(const std::string& out, const std::string& extra = "") {
+  const Outcome o = cli("run " + kSource + "/scenarios/two_finger_lift.lua --quiet --out " +
+                        out + " " + extra);
+  INFO(o.output);
+  REQUIRE(o.status == 0);
+  REQUIRE(std::filesystem::exists(out));
+}
+
+// Adds `delta` to element (row, column) of dataset `path`, returning the new value.
+double nudge(const std::string& file, const std::string& path, hsize_t row, hsize_t column, double delta) {
+  const hid_t f = H5Fopen(file.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
+  REQUIRE(f >= 0);
+  const hid_t d = H5Dopen2(f, path.c_str(), H5P_DEFAULT);
+  REQUIRE(d >= 0);
+  const hid_t space = H5Dget_space(d);
+  const hsize_t offset[2] = {row, column};
+  const hsize_t count[2] = {1, 1};
+  REQUIRE(H5Sselect_hyperslab(space, H5S_SELECT_SET, offset, nullptr, count, nullptr) >= 0);
+  const hid_t memory = H5Screate_simple(2, count, nullptr);
+  double value = 0.0;
+  REQUIRE(H5Dread(d, H5T_NATIVE_DOUBLE, memory, space, H5P_DEFAULT, &value) >= 0);
+  value += delta;
+  REQUIRE(H5Dwrite(d, H5T_NATIVE_DOUBLE, memory, space, H5P_DEFAULT, &value) >= 0);
+  H5Sclose(memory);
+  H5Sclose(space);
+  H5Dclose(d);
+  H5Fclose(f);
+  return value;
+}
+
+// A minimal JSON syntax checker (RFC 8259 grammar; numbers loosely): true if `text` is one
+// JSON value with only whitespace around it.
+class JsonChecker {
+ public:
+  explicit JsonChecker(const std::string& text) : s_(text) {}
+  bool valid() {
+    skip();
+    if (!value()) return false;
+    skip();
+    return i_ == s_.size();
+  }
+
+ private:
+  void skip() {
+    while (i_ < s_.size() && std::isspace(static_cast<unsigned char>(s_[i_]))) ++i_;
+  }
+  bool literal(const char* word) {
+    const std::string w = word;
+    if (s_.compare(i_, w.size(), w) != 0) return false;
+    i_ += w.size();
+    return true;
+  }
+  bool string() {
+    if (i_ >= s_.size() || s_[i_] != '"') return false;
+    for (++i_; i_ < s_.size(); ++i_) {
+      const unsigned char c = static_cast<unsigned char>(s_[i_]);
+      if (c == '"') return ++i_, true;
+      if (c < 0x20) return false;
+      if (c == '\\') ++i_;
+    }
+    return false;
+  }
+  bool number() {
+    const std::size_t start = i_;
+    if (i_ < s_.size() && s_[i_] == '-') ++i_;
+    while (i_ < s_.size() && (std::isdigit(static_cast<unsigned char>(s_[i_])) || s_[i_] == '.' ||
+                              s_[i_] == 'e' || s_[i_] == 'E' || s_[i_] == '+' || s_[i_] == '-'))
+      ++i_;
+    return i_ > start && std::isdigit(static_cast<unsigned char>(s_[i_ - 1]));
+  }
+  bool value() {
+    skip();
+    if (i_ >= s_.size()) return false;
+    const char c = s_[i_];
+    if (c == '{') return compound('}', true);
+    if (c == '[') return compound(']', false);
+    if (c == '"') return string();
+    if (c == 't') return literal("true");
+    if (c == 'f') return literal("false");
+    if (c == 'n') return literal("null");
+    return number();
+  }
+  bool compound(char close, bool object) {
+    ++i_;
+    skip();
+    if (i_ < s_.size() && s_[i_] == close) return ++i_, true;
+    while (true) {
+      skip();
+      if (object) {
+        if (!string()) return false;
+        skip();
+        if (i_ >= s_.size() || s_[i_++] != ':') return false;
+      }
+      if (!value()) return false;
+      skip();
+      if (i_ >= s_.size()) return false;
+      if (s_[i_] == ',') { ++i_; continue; }
+      if (s_[i_] == close) return ++i_, true;
+      return false;
+    }
+  }
+  const std::string& s_;
+  std::size_t i_ = 0;
+};
+
+}  // namespace
+
+TEST_CASE("the JSON checker of this test accepts JSON and refuses broken text", "[compare_cli]") {
+  CHECK(JsonChecker(R"({"a": [1, -2.5e-9, "x\"y", null, true, {}], "b": {"c": []}})").valid());
+  CHECK_FALSE(JsonChecker(R"({"a": 1,})").valid());
+  CHECK_FALSE(JsonChecker(R"({"a": nan})").valid());
+  CHECK_FALSE(JsonChecker(R"({"a": "x
+"})").valid());
+  CHECK_FALSE(JsonChecker(R"({"a": 1} x)").valid());
+}
+
+TEST_CASE("graspsim compare finds a 1e-9 m change at its tick, time, object and component", "[compare_cli]") {
+  const std::string a = kTmp + "/compare_cli_a.h5", b = kTmp + "/compare_cli_b.h5";
+  run_lift(a);
+  run_lift(b);
+
+  // Two runs of the same scenario: bitwise identical (root attributes that differ, such as a
+  // wall-clock one, would only be notes).
+  Outcome o = cli("compare " + a + " " + b + " --bitwise");
+  INFO(o.output);
+  CHECK(o.status == 0);
+  CHECK_THAT(o.output, Catch::Contains("SAME: bitwise identical"));
+
+  // Physics row 20 is servo tick 20 * (servo rate / physics rate).
+  nudge(b, "/physics/objects/box/position", 20, 2, 1e-9);
+  o = cli("compare " + a + " " + b);
+  INFO(o.output);
+  CHECK(o.status == 1);
+  const std::string first_line = "DIFFERENT: 1 of ";
+  CHECK_THAT(o.output, Catch::Contains(first_line));
+  // The rates, from the JSON of a comparison of A with itself (not assumed here).
+  const Outcome rates = cli("compare " + a + " " + a + " --json", false);
+  const auto servo_at = rates.output.find("\"servo\": ");
+  const auto physics_at = rates.output.find("\"physics\": ");
+  REQUIRE(servo_at != std::string::npos);
+  REQUIRE(physics_at != std::string::npos);
+  const long servo = std::stol(rates.output.substr(servo_at + 9));
+  const long physics = std::stol(rates.output.substr(physics_at + 11));
+  const long tick = 20 * (servo / physics);
+  char time[64];
+  std::snprintf(time, sizeof time, "t = %.6g s", static_cast<double>(tick) / servo);
+  CHECK_THAT(o.output, Catch::Contains("first at physics tick " + std::to_string(tick) + " (" + time +
+                                       "): object box position z"));
+
+  // A tolerance above the change passes, one below fails; a per-dataset one overrides.
+  CHECK(cli("compare " + a + " " + b + " --atol 2e-9").status == 0);
+  CHECK(cli("compare " + a + " " + b + " --atol 5e-10").status == 1);
+  CHECK(cli("compare " + a + " " + b + " --tol physics/objects/box/position=2e-9").status == 0);
+  CHECK(cli("compare " + a + " " + b + " --atol 1 --tol 'physics/objects/box/*=1e-10'").status == 1);
+  CHECK(cli("compare " + a + " " + b + " --tol 'physics/*=1e-10,1e-6'").status == 0);   // rtol
+
+  // --json: valid JSON naming the tick, dataset, object and component.
+  o = cli("compare " + a + " " + b + " --json", false);
+  INFO(o.output);
+  CHECK(o.status == 1);
+  CHECK(JsonChecker(o.output).valid());
+  CHECK_THAT(o.output, Catch::Contains("\"same\": false"));
+  CHECK_THAT(o.output, Catch::Contains("\"exit_code\": 1"));
+  CHECK_THAT(o.output, Catch::Contains("\"differing_datasets\": 1,"));
+  CHECK_THAT(o.output, Catch::Contains("{\"path\": \"physics/objects/box/position\", \"loop\": \"physics\", "
+                                       "\"kind\": \"object\", \"name\": \"box\", \"quantity\": \"position\""));
+  CHECK_THAT(o.output, Catch::Contains("\"first\": {\"tick\": " + std::to_string(tick) + ", "));
+  CHECK_THAT(o.output, Catch::Contains("\"component\": \"z\""));
+  // The identical comparison is valid JSON too.
+  CHECK(JsonChecker(rates.output).valid());
+  CHECK_THAT(rates.output, Catch::Contains("\"same\": true"));
+}
+
+TEST_CASE("graspsim compare refuses unusable input with exit status 2", "[compare_cli][bad_input]") {
+  const std::string a = kTmp + "/compare_cli_bad_a.h5";
+  run_lift(a);
+  const std::string physics100 = kTmp + "/compare_cli_bad_rate.h5";
+  run_lift(physics100, "--set rates.physics=100");
+  const std::string text = kTmp + "/compare_cli_text.h5";
+  std::ofstream(text) << "hello\n";
+  const std::string cut = kTmp + "/compare_cli_cut.h5";
+  std::filesystem::remove(cut);
+  std::filesystem::copy_file(a, cut);
+  std::filesystem::resize_file(cut, std::filesystem::file_size(a) / 3);
+  // A copy without one dataset.
+  const std::string fewer = kTmp + "/compare_cli_fewer.h5";
+  std::filesystem::remove(fewer);
+  std::filesystem::copy_file(a, fewer);
+  {
+    const hid_t f = H5Fopen(fewer.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
+    REQUIRE(f >= 0);
+    REQUIRE(H5Ldelete(f, "/physics/objects/box/torque", H5P_DEFAULT) >= 0);
+    H5Fclose(f);
+  }
+
+  struct Case { std::string args; std::vector<std::string> says; };
+  const std::vector<Case> cases = {
+      {"compare " + a, {"two trace files"}},
+      {"compare " + a + " " + kTmp + "/compare_nowhere.h5", {"compare_nowhere.h5", "no such file"}},
+      {"compare " + a + " " + text, {"compare_cli_text.h5", "not an HDF5 file"}},
+      {"compare " + cut + " " + a, {"compare_cli_cut.h5"}},
+      {"compare " + a + " " + physics100, {"different rates", "/ 100 Hz", "compare_cli_bad_rate.h5"}},
+      {"compare " + a + " " + fewer, {"'/physics/objects/box/torque'", "missing in '" + fewer + "'"}},
+      {"compare " + a + " " + a + " --tol nothing/here=1", {"'nothing/here' matches no dataset"}},
+      {"compare " + a + " " + a + " --tol box=", {"--tol needs PATTERN=ATOL"}},
+      {"compare " + a + " " + a + " --atol -1", {"--atol needs a number >= 0"}},
+      {"compare " + a + " " + a + " --bitwise --atol 1", {"--bitwise"}},
+  };
+  for (const Case& c : cases) {
+    const Outcome o = cli(c.args);
+    INFO("graspsim " << c.args << "\n" << o.output);
+    CHECK(o.status == 2);
+    for (const std::string& s : c.says) CHECK_THAT(o.output, Catch::Contains(s));
+  }
+  // With --json the error is a JSON object on stdout as well.
+  const Outcome o = cli("compare " + a + " " + text + " --json", false);
+  CHECK(o.status == 2);
+  CHECK(JsonChecker(o.output).valid());
+  CHECK_THAT(o.output, Catch::Contains("\"exit_code\": 2"));
+  // The inputs are left as they were.
+  CHECK(std::filesystem::file_size(text) == 6);
+}
+
+TEST_CASE("graspsim compare --help explains tolerances, exit codes and h5diff", "[compare_cli]") {
+  const Outcome o = cli("compare --help");
+  CHECK(o.status == 0);
+  for (const char* s : {"--atol", "--rtol", "--tol PATTERN=ATOL", "--bitwise", "--json", "--attributes",
+                        "exit status", "h5diff", "servo/*"})
+    CHECK_THAT(o.output, Catch::Contains(s));
+}
