@@ -6,13 +6,27 @@
 #include <cmath>
 #include <functional>
 #include <map>
+#include <string>
 #include <memory>
 #include <vector>
 
+#include "graspsim/engine/model.hpp"
 #include "graspsim/engine/shape.hpp"
 #include "test_shape_meshes.hpp"
 
 namespace graspsim::test {
+
+// A body that barely moves: 1e12 kg, so that 30 N move it by < 1e-11 m in 1 s (no gravity in the
+// tests that use it); checks read its recorded pose.
+inline BodyParams fixed_body(const std::string& name, const Shape& shape, const Material& material) {
+  BodyParams b;
+  b.name = name;
+  b.shape = shape;
+  b.mass = 1e12;
+  b.inertia = box_inertia(b.mass, Vec3(0.05, 0.05, 0.05));
+  b.material = material;
+  return b;
+}
 
 // The closed surface of the union of grid cells (i, j, k), 0 <= i < n.x() etc., for which
 // `filled` is true, each cell of size `cell` (m), the grid's low corner at `origin`: one quad

@@ -14,20 +14,6 @@
 using namespace graspsim;
 using graspsim::test::make_finger;
 
-namespace {
-
-// A body that barely moves (1e12 kg: 30 N move it by < 1e-11 m in 1 s); checks read its pose.
-BodyParams heavy(const std::string& name, const Shape& shape, const Material& material) {
-  BodyParams b;
-  b.name = name;
-  b.shape = shape;
-  b.mass = 1e12;
-  b.inertia = box_inertia(b.mass, Vec3(0.05, 0.05, 0.05));
-  b.material = material;
-  return b;
-}
-
-}  // namespace
 
 // Analytic sphere of R = 4 cm, frictionless, finger k = 800 N/m with a pad of r = 0 or 5 mm:
 // f = k (R + r - |p - c|) (p - c)/|p - c| whenever |p - c| < R + r, else 0, at every tick
@@ -39,7 +25,7 @@ TEST_CASE("an analytic sphere pushes back radially with k (R + r - |p - c|)", "[
     Model m;
     m.gravity = Vec3::Zero();
     m.rates = Rates{1000, 1000, 1000};
-    m.bodies.push_back(heavy("ball", sphere_shape(R), Material{0.0, kInfinity, kInfinity}));
+    m.bodies.push_back(graspsim::test::fixed_body("ball", sphere_shape(R), Material{0.0, kInfinity, kInfinity}));
     FingerParams f = make_finger("finger", k);
     f.radius = r;
     m.fingers.push_back(f);
@@ -85,7 +71,7 @@ TEST_CASE("a sticking finger does not slip over an edge while the chord is withi
     Model m;
     m.gravity = Vec3::Zero();
     m.rates = Rates{1000, 1000, 1000};
-    m.bodies.push_back(heavy("roof", graspsim::test::convex_shape(roof), Material{mu, kInfinity, kInfinity}));
+    m.bodies.push_back(graspsim::test::fixed_body("roof", graspsim::test::convex_shape(roof), Material{mu, kInfinity, kInfinity}));
     m.fingers.push_back(make_finger("finger", k));
     Simulation sim(m);
     const Vec3 p0(-0.0001, 0.001, h - 0.0001 * h / w);   // on the left slope, 0.1 mm from the ridge
@@ -185,7 +171,7 @@ TEST_CASE("two_point_grasp opposes by the stored contact normals", "[finger_cont
   for (double spread : {M_PI / 6.0, 5.0 * M_PI / 6.0}) {
     Model m;
     m.gravity = Vec3::Zero();
-    m.bodies.push_back(heavy("ball", sphere_shape(R), Material{0.8, kInfinity, kInfinity}));
+    m.bodies.push_back(graspsim::test::fixed_body("ball", sphere_shape(R), Material{0.8, kInfinity, kInfinity}));
     m.fingers.push_back(make_finger("a", 400.0));
     m.fingers.push_back(make_finger("b", 400.0));
     Simulation sim(m);

@@ -12,14 +12,6 @@ using namespace graspsim;
 
 namespace {
 
-Shape round_shape(ShapeKind kind, double radius, double half_length) {
-  Shape s;
-  s.kind = kind;
-  s.radius = radius;
-  s.half_length = half_length;
-  return s;
-}
-
 // Enters along a -> b, then tracks through `path`, calling `each(hip, track)` at every point;
 // REQUIREs the contact to hold throughout.
 template <class F>
@@ -50,7 +42,7 @@ std::vector<Vec3> segment(const Vec3& a, const Vec3& b, int steps) {
 TEST_CASE("an analytic sphere: SP radial at R + r, depth R + r - |p|", "[surface][sphere][law]") {
   const double R = 0.04;
   for (double r : {0.0, 0.005}) {
-    const SurfaceGeometry g(round_shape(ShapeKind::kSphere, R, 0.0));
+    const SurfaceGeometry g(sphere_shape(R));
     // Entry from outside along -x: at x = R + r.
     const auto e = surface_entry(g, r, Vec3(0.1, 0.001, 0.0), Vec3(0.0, 0.001, 0.0));
     REQUIRE(e);
@@ -88,7 +80,7 @@ TEST_CASE("an analytic sphere: SP radial at R + r, depth R + r - |p|", "[surface
 TEST_CASE("a capsule: SP about the closest axis point, smooth over the rim", "[surface][capsule][law]") {
   const double R = 0.02, L = 0.03, d = 0.002;
   for (double r : {0.0, 0.004}) {
-    const SurfaceGeometry g(round_shape(ShapeKind::kCapsule, R, L));
+    const SurfaceGeometry g(capsule_shape(R, L));
     // Up the side at depth d, then over the top hemisphere, to the pole.
     std::vector<Vec3> path;
     for (int i = 0; i <= 100; ++i) path.emplace_back(R + r - d, 0.0, -0.01 + 0.04 * i / 100.0);
@@ -118,7 +110,7 @@ TEST_CASE("a capsule: SP about the closest axis point, smooth over the rim", "[s
 // cap beyond the bottom, it stays on the cap.
 TEST_CASE("a cylinder: a point finger keeps its side up to the rim and its cap through the body", "[surface][cylinder][law]") {
   const double R = 0.02, L = 0.03;
-  const SurfaceGeometry g(round_shape(ShapeKind::kCylinder, R, L));
+  const SurfaceGeometry g(cylinder_shape(R, L));
   const auto e = surface_entry(g, 0.0, Vec3(0.05, 0.0, 0.0), Vec3(0.015, 0.0, 0.0));
   REQUIRE(e);
   CHECK(e->point.x() == Approx(R).margin(1e-12));
@@ -155,7 +147,7 @@ TEST_CASE("a cylinder: a point finger keeps its side up to the rim and its cap t
 // normal turns from +x to +z.
 TEST_CASE("a cylinder with a pad: over the rounded rim from side to cap", "[surface][cylinder][pad][law]") {
   const double R = 0.02, L = 0.03, r = 0.005, d = 0.002, step = 0.0002;
-  const SurfaceGeometry g(round_shape(ShapeKind::kCylinder, R, L));
+  const SurfaceGeometry g(cylinder_shape(R, L));
   std::vector<Vec3> path;
   for (double z = L - 0.01; z < L; z += step) path.emplace_back(R + r - d, 0.0, z);
   const int arc = 60;

@@ -15,17 +15,6 @@ using graspsim::test::make_finger;
 
 namespace {
 
-// A body that barely moves: no gravity in the tests that use it, and a mass of 1e12 kg, so
-// that 20 N move it by 0.5 (F/m) t^2 < 4e-12 m in 0.6 s; the checks read its recorded pose.
-BodyParams fixed_body(const std::string& name, const Shape& shape, const Material& material) {
-  BodyParams b;
-  b.name = name;
-  b.shape = shape;
-  b.mass = 1e12;
-  b.inertia = box_inertia(b.mass, Vec3(0.05, 0.05, 0.05));
-  b.material = material;
-  return b;
-}
 
 // The HIP in the body's frame from a tick record (body 0, every loop at one rate).
 Vec3 to_body(const TickRecord& rec, const Vec3& world) {
@@ -62,7 +51,7 @@ TEST_CASE("a 2 mm plate pressed at 20 N keeps the contact on the entered face", 
         Model m;
         m.gravity = Vec3::Zero();
         m.rates = Rates{1000, 1000, 1000};
-        m.bodies.push_back(fixed_body("plate", shape, Material{0.0, kInfinity, kInfinity}));
+        m.bodies.push_back(graspsim::test::fixed_body("plate", shape, Material{0.0, kInfinity, kInfinity}));
         FingerParams f = make_finger("finger", k);
         f.radius = r;
         m.fingers.push_back(f);
@@ -282,7 +271,7 @@ TEST_CASE("pressed into a concave edge and a concave corner of a mesh", "[traver
     Model m;
     m.gravity = Vec3::Zero();
     m.rates = Rates{1000, 1000, 1000};
-    m.bodies.push_back(fixed_body("solid", graspsim::test::mesh_shape(cs.mesh), Material{0.0, kInfinity, kInfinity}));
+    m.bodies.push_back(graspsim::test::fixed_body("solid", graspsim::test::mesh_shape(cs.mesh), Material{0.0, kInfinity, kInfinity}));
     m.fingers.push_back(make_finger("finger", k));
     Simulation sim(m);
     const Vec3 above = cs.above, into(cs.above.x(), cs.above.y(), 0.017);
