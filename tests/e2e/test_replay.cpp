@@ -135,6 +135,14 @@ TEST_CASE("replay of gimbal_twist (scripted gimbal pitch) is the recording bit f
   check_reproduced("gimbal_twist.lua", "gimbal");
 }
 
+// The thumb's script watches the rod through the simulation view and keeps the swing and the
+// hand-to-centre band for the expectations: replayed, the scripts still run (their motion
+// unused), so they see the same run and the expectations hold as they did.
+TEST_CASE("replay of rod_swing (expectations fed by a watching script) is the recording bit for bit",
+          "[e2e][replay]") {
+  check_reproduced("rod_swing.lua", "rod");
+}
+
 // Relative mesh files resolve against the recorded scenario_path's directory.
 TEST_CASE("replay of mesh_grasp reads its mesh from the recorded scenario's directory", "[e2e][replay]") {
   check_reproduced("mesh_grasp.lua", "mesh");

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <memory>
 #include <stdexcept>
 
 #include "graspsim/hw/replay_device.hpp"
@@ -49,4 +50,27 @@ TEST_CASE("ReplayDevice renders through the same clamp as every device", "[hw][r
   CHECK(d.last_force() == r);
   d.release();
   CHECK(d.last_force() == Vec3::Zero());
+}
+
+namespace {
+// A script that remembers the times it was asked for and answers something else entirely.
+struct Recorder final : graspsim::hw::Trajectory {
+  std::vector<double>* times;
+  explicit Recorder(std::vector<double>* t) : times(t) {}
+  graspsim::hw::TrajectorySample sample(double t) override {
+    times->push_back(t);
+    return {Vec3(9.0, 9.0, 9.0), Vec3(1.0, 1.0, 1.0)};
+  }
+};
+}  // namespace
+
+TEST_CASE("ReplayDevice still runs the finger's script at every read, and ignores its motion",
+          "[hw][replay]") {
+  std::vector<double> times;
+  ReplayDevice d({Vec3(0.1, 0.2, 0.3), Vec3(0.4, 0.5, 0.6)}, {Vec3::Zero(), Vec3::Zero()}, DeviceLimits{}, "t.h5",
+                 std::make_unique<Recorder>(&times));
+  CHECK(d.read(0, 0.0).position == Vec3(0.1, 0.2, 0.3));
+  CHECK(d.read(1, 1.0 / 3000.0).position == Vec3(0.4, 0.5, 0.6));
+  CHECK(d.read(1, 1.0 / 3000.0).gimbal == Vec3::Zero());
+  CHECK(times == std::vector<double>{0.0, 1.0 / 3000.0, 1.0 / 3000.0});
 }

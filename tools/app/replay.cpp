@@ -163,7 +163,8 @@ RunOptions ReplayPlan::run_options(const std::string& out) const {
   options.attributes.emplace_back("replay_of", replay_of());
   options.make_device = [this](std::size_t f) -> std::unique_ptr<hw::Device> {
     return std::make_unique<hw::ReplayDevice>(fingers[f].hip, fingers[f].gimbal, scenario->fingers()[f].limits,
-                                              trace + " /servo/fingers/" + scenario->model().fingers[f].name);
+                                              trace + " /servo/fingers/" + scenario->model().fingers[f].name,
+                                              scenario->make_trajectory(f));
   };
   return options;
 }

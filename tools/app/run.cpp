@@ -190,7 +190,7 @@ RunResult run_scenario(const scripting::Scenario& scenario, const RunOptions& op
     // The read-only view trajectory functions get: the state as the last physics tick left it
     // (before the first tick: the initial state, fingers at zero and free). Updated only when a
     // physics tick ran, and only if some trajectory function takes it.
-    const bool view = scenario.uses_view() && !options.make_device;   // replayed devices read no view
+    const bool view = scenario.uses_view();
     scripting::Snapshot view_state;
     if (view) {
       fill_snapshot(sim, record, slip, view_state);
