@@ -81,11 +81,16 @@ Scenario& Scenario::operator=(Scenario&&) noexcept = default;
 Scenario::~Scenario() = default;
 
 Scenario Scenario::load(const std::string& path, const LoadOptions& options) {
+  return load_source(read_file(path), path, options);
+}
+
+Scenario Scenario::load_source(const std::string& source, const std::string& path,
+                               const LoadOptions& options) {
   // Declared before the scenario: param() points at it until the Lua state is closed.
   std::vector<detail::Override> overrides;
   Scenario s;
   s.path_ = path;
-  s.source_ = read_file(path);
+  s.source_ = source;
   try {
     overrides = detail::parse_overrides(options.sets);
     s.lua_ = std::make_unique<LuaSandbox>(options.limits);
@@ -125,7 +130,9 @@ Scenario Scenario::load(const std::string& path, const LoadOptions& options) {
     const detail::LuaValue table = detail::read_value(state, root, &lua);
     lua_settop(state, top);
     detail::ScenarioParts parts = detail::convert_scenario(
-        table, default_name(path), std::filesystem::path(path).parent_path().string());
+        table, default_name(path),
+        options.base_directory.empty() ? std::filesystem::path(path).parent_path().string()
+                                       : options.base_directory);
     s.parameters_ = detail::flatten_parameters(table, params);
     s.name_ = std::move(parts.name);
     s.description_ = std::move(parts.description);

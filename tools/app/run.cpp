@@ -141,6 +141,7 @@ RunResult run_scenario(const scripting::Scenario& scenario, const RunOptions& op
   writer.set_attribute("graspsim_version", GRASPSIM_VERSION);
   writer.set_attribute("compiler", std::string("g++ ") + __VERSION__);
   writer.set_attribute("build_flags", GRASPSIM_BUILD_FLAGS);
+  for (const auto& [name, value] : options.attributes) writer.set_attribute(name, value);
 
   std::vector<std::unique_ptr<hw::Device>> devices;
   std::vector<double> slip(model.fingers.size(), 0.0);
@@ -157,8 +158,9 @@ RunResult run_scenario(const scripting::Scenario& scenario, const RunOptions& op
   try {
     std::ostringstream device_list;
     for (std::size_t f = 0; f < model.fingers.size(); ++f) {
-      devices.push_back(std::make_unique<hw::ScriptedFinger>(scenario.make_trajectory(f),
-                                                             scenario.fingers()[f].limits));
+      if (options.make_device) devices.push_back(options.make_device(f));
+      else devices.push_back(std::make_unique<hw::ScriptedFinger>(scenario.make_trajectory(f),
+                                                                  scenario.fingers()[f].limits));
       device_list << model.fingers[f].name << ": " << devices.back()->describe()
                   << " (max force " << devices.back()->limits().max_force << " N)\n";
     }
@@ -171,6 +173,7 @@ RunResult run_scenario(const scripting::Scenario& scenario, const RunOptions& op
     TickRecord record = make_tick_record(model);
     std::vector<Vec3> rendered(model.fingers.size(), Vec3::Zero());
     const auto ticks = static_cast<std::int64_t>(std::llround(scenario.duration() * model.rates.servo));
+    const std::int64_t run_ticks = options.max_ticks >= 0 ? std::min(ticks, options.max_ticks) : ticks;
 
     // Expectations in the order they fall due: (tick, index), so ties keep the scenario's order.
     std::vector<std::pair<std::int64_t, std::size_t>> due;
@@ -205,7 +208,7 @@ RunResult run_scenario(const scripting::Scenario& scenario, const RunOptions& op
     auto last_flush = start;
     const std::int64_t flush_ticks =
         std::max<std::int64_t>(1, static_cast<std::int64_t>(std::floor(kFlushSimulated * model.rates.servo)));
-    for (std::int64_t n = 0; n < ticks; ++n) {
+    for (std::int64_t n = 0; n < run_ticks; ++n) {
       const double t = sim.time();
       for (std::size_t f = 0; f < devices.size(); ++f) {
         const hw::DeviceSample sample = devices[f]->read(n, t);
@@ -262,8 +265,8 @@ RunResult run_scenario(const scripting::Scenario& scenario, const RunOptions& op
         }
       }
     }
-    if (ticks == 0) initial = snapshot(sim, record, slip);
-    check_due(ticks);
+    if (run_ticks == 0) initial = snapshot(sim, record, slip);
+    check_due(run_ticks);
   } catch (const std::exception& e) {
     result.error = e.what();
   }

@@ -6,9 +6,11 @@
 #include <atomic>
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
+#include "graspsim/hw/device.hpp"
 #include "graspsim/scripting/scenario.hpp"
 
 namespace graspsim::app {
@@ -25,6 +27,12 @@ struct RunOptions {
   // `overrides` attribute: with the scenario source they reload the same scenario (replay).
   std::vector<std::string> overrides;
   bool write_trace = true;   // false: no trace at all (the logging benchmark's baseline)
+  // Replay (tools/app/replay.hpp): the device of finger f instead of its scripted trajectory
+  // (empty: scripted); at most `max_ticks` servo ticks (< 0: the scenario's duration; expectations
+  // due later are reported as not checked); extra root string attributes (`replay_of`).
+  std::function<std::unique_ptr<hw::Device>(std::size_t finger)> make_device;
+  std::int64_t max_ticks = -1;
+  std::vector<std::pair<std::string, std::string>> attributes;
 };
 
 struct RunResult {

@@ -14,6 +14,7 @@
 #include "app/compare.hpp"
 #include "app/run.hpp"
 #include "cli/repair.hpp"
+#include "cli/replay.hpp"
 #include "graspsim_version.hpp"
 #include "graspsim/recordings/trace_writer.hpp"
 #include "graspsim/scripting/scenario.hpp"
@@ -29,6 +30,7 @@ constexpr int kExitInterrupted = 130; // Ctrl-C (128 + SIGINT)
 
 constexpr const char* kUsage =
     "usage: graspsim run SCENARIO.lua [--out FILE.h5] [--duration S] [--set NAME=VALUE]...\n"
+    "       graspsim replay TRACE.h5 [--out NEW.h5] [--set NAME=VALUE]...\n"
     "       graspsim repair TRACE.h5\n"
     "       graspsim compare A.h5 B.h5 [--atol X] [--rtol X] [--tol PATTERN=ATOL[,RTOL]]...\n"
     "                [--bitwise] [--attributes] [--all-ticks] [--all] [--json]\n"
@@ -61,6 +63,11 @@ constexpr const char* kHelp =
     "A run killed outright leaves status \"running\" and every tick up to its last flush\n"
     "(at most 0.25 s simulated or 1 s wall old): h5py opens it with swmr=True; after\n"
     "`graspsim repair TRACE.h5` (see `graspsim repair --help`) every HDF5 tool does.\n"
+    "\n"
+    "usage: graspsim replay TRACE.h5 [options]   (graspsim replay --help for more)\n"
+    "\n"
+    "Reruns a trace's scenario with every finger fed from its recorded device samples; the\n"
+    "new trace equals the recording bit for bit, or, with --set, shows where 'what if' parts.\n"
     "\n"
     "usage: graspsim compare A.h5 B.h5 [options]   (graspsim compare --help for more)\n"
     "\n"
@@ -350,6 +357,10 @@ int main(int argc, char** argv) {
     return kExitOk;
   }
   if (command == "run") return run_command({args.begin() + 1, args.end()});
+  if (command == "replay") {
+    std::signal(SIGINT, on_sigint);
+    return graspsim::cli::replay_command({args.begin() + 1, args.end()}, &g_interrupt);
+  }
   if (command == "repair") return graspsim::cli::repair_command({args.begin() + 1, args.end()});
   if (command == "compare") return compare_command({args.begin() + 1, args.end()});
   return bad_input("unknown command '" + command + "'\n" + kUsage + "Try 'graspsim --help'.");

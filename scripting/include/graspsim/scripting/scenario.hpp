@@ -67,6 +67,9 @@ struct LoadOptions {
   std::vector<std::string> sets;
   // Memory limit and instruction budgets of the Lua state the scenario runs in.
   SandboxLimits limits;
+  // Directory that relative file names in the scenario (mesh `file`s) are read from; "" means
+  // the scenario file's own directory. A replay sets it: its source comes from a trace.
+  std::string base_directory;
 };
 
 class Scenario {
@@ -74,6 +77,10 @@ class Scenario {
   // Loads, runs (sandboxed, with an instruction budget) and converts a scenario file.
   // Throws ScenarioError with a message naming the file and line or the field.
   static Scenario load(const std::string& path, const LoadOptions& options = {});
+  // The same from text already read (a trace's scenario_source): `path` names it in messages
+  // and tracebacks and, unless options.base_directory is set, places its relative file names.
+  static Scenario load_source(const std::string& source, const std::string& path,
+                              const LoadOptions& options = {});
 
   Scenario(Scenario&&) noexcept;
   Scenario& operator=(Scenario&&) noexcept;

@@ -1,0 +1,64 @@
+// Replaying a trace: the recorded scenario (the trace's own scenario_source and overrides, plus
+// any new --set) rerun with every finger fed from its recorded device samples (/servo hip and
+// gimbal, row n = servo tick n) instead of its script. The trace is read here (HDF5 stays out
+// of hw/ and engine/); the fingers are hw::ReplayDevice. See README.md, "Replaying a trace".
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "app/run.hpp"
+#include "graspsim/hw/device.hpp"
+#include "graspsim/scripting/scenario.hpp"
+
+namespace graspsim::app {
+
+// The trace cannot be replayed as asked (not a trace, no device inputs, a finger or rate that
+// does not match, a scenario that does not load): a message naming the file and the dataset,
+// attribute or field. The CLI exits 2.
+class ReplayError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+struct ReplayOptions {
+  std::vector<std::string> sets;   // --set NAME=VALUE given to replay, applied after the recorded ones
+  // Directory that relative file names of the scenario (mesh files) are read from; "" means the
+  // directory of the recorded scenario_path, taken relative to the working directory (as the
+  // original run did when it ran from the same place).
+  std::string scenario_dir;
+};
+
+// One finger's recorded inputs, one element per servo tick.
+struct RecordedFinger {
+  std::vector<hw::Vec3> hip;      // m, world
+  std::vector<hw::Vec3> gimbal;   // rad (roll, pitch, yaw)
+};
+
+struct ReplayPlan {
+  std::string trace;                      // the trace replayed, as given
+  std::string status;                     // its root `status`
+  std::string scenario_path;              // recorded scenario_path
+  std::string scenario_source_hash;       // recorded scenario_source_hash
+  std::vector<std::string> overrides;     // recorded overrides, then ReplayOptions::sets
+  std::unique_ptr<scripting::Scenario> scenario;   // loaded from the trace's source
+  std::vector<RecordedFinger> fingers;    // Model::fingers order
+  std::int64_t recorded_ticks = 0;        // servo ticks with a sample for every finger
+  std::int64_t scenario_ticks = 0;        // duration * rate_servo of the (overridden) scenario
+  bool what_if = false;                   // ReplayOptions::sets was not empty
+  std::vector<std::string> notes;         // e.g. a cut trace replayed up to its last tick
+  // The root attribute a replay trace carries: "<trace as given>\n<its scenario_source_hash>".
+  std::string replay_of() const;
+  // RunOptions that replay this plan (devices, max_ticks, overrides, replay_of) into `out`.
+  // The plan must outlive the run.
+  RunOptions run_options(const std::string& out) const;
+};
+
+// Reads the trace's scenario and device samples and checks that they can be replayed.
+// Throws ReplayError (bad input) with the file and the dataset, attribute or field named.
+ReplayPlan load_replay(const std::string& trace, const ReplayOptions& options = {});
+
+}  // namespace graspsim::app

@@ -1,0 +1,188 @@
+// graspsim replay TRACE.h5: the recorded scenario, fed from the recorded device samples
+// (README.md, "Replaying a trace").
+#include "cli/replay.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <iostream>
+
+#include "app/replay.hpp"
+#include "app/run.hpp"
+#include "graspsim/recordings/trace_compare.hpp"
+
+namespace graspsim::cli {
+namespace {
+
+constexpr const char* kReplayHelp =
+    "usage: graspsim replay TRACE.h5 [--out NEW.h5] [--set NAME=VALUE]... [options]\n"
+    "\n"
+    "Reruns the scenario recorded in TRACE.h5 (its own scenario_source text and overrides, so\n"
+    "it works when the scenario file has changed or moved) with every finger fed, servo tick by\n"
+    "servo tick, from the recorded device samples (/servo/fingers/<finger>/hip and gimbal)\n"
+    "instead of its script, writes a new trace, checks the scenario's expectations, and\n"
+    "compares the new trace with the recording bit for bit (every dataset, including the\n"
+    "/physics/state_hash of every physics tick).\n"
+    "\n"
+    "Without --set the replay must reproduce the recording: it says so, or names the first\n"
+    "tick and quantity where it does not. With --set it answers 'what if' (the same hand\n"
+    "motion, another mu: --set mu=0.4) and names where the two runs part; `graspsim compare\n"
+    "TRACE.h5 NEW.h5` lists every difference.\n"
+    "\n"
+    "options:\n"
+    "  --out FILE.h5        the new trace (default: <TRACE stem>.replay.h5 in this directory);\n"
+    "                       never the trace replayed\n"
+    "  --set NAME=VALUE     override a scenario value, after the recorded overrides (rates\n"
+    "                       cannot change: the samples are one per recorded servo tick;\n"
+    "                       a longer duration replays up to the last recorded tick)\n"
+    "  --scenario-dir DIR   read the scenario's relative file names (meshes) from DIR instead\n"
+    "                       of the recorded scenario_path's directory\n"
+    "  --compress N         deflate the new trace at level N (1..9)\n"
+    "  --quiet              print only errors, failed expectations and differences\n"
+    "\n"
+    "A trace cut by a crash (status running, cut: repaired) or stopped by an error is replayed\n"
+    "up to its last recorded servo tick; expectations due later are reported as not checked.\n"
+    "\n"
+    "exit status: 0 reproduced (with --set: ran) and every expectation held, 1 an expectation\n"
+    "failed or a replay without --set differs from the recording, 2 bad input (not a graspsim\n"
+    "trace, a schema 1 trace without device inputs, a scenario finger the trace lacks, rates\n"
+    "changed by --set, a scenario that does not load, an unwritable output), 130 interrupted.\n";
+
+int bad_input(const std::string& message) {
+  std::cerr << "graspsim: " << message << "\n";
+  return 2;
+}
+
+std::string default_out(const std::string& trace) {
+  return std::filesystem::path(trace).stem().string() + ".replay.h5";
+}
+
+}  // namespace
+
+int replay_command(const std::vector<std::string>& args, const std::atomic<bool>* interrupt) {
+  std::string trace, out;
+  app::ReplayOptions replay;
+  int compression = 0;
+  bool quiet = false;
+  for (std::size_t i = 0; i < args.size(); ++i) {
+    const std::string& a = args[i];
+    const std::string* v = (i + 1 < args.size()) ? &args[i + 1] : nullptr;
+    const auto take = [&] { ++i; };
+    if (a == "-h" || a == "--help") {
+      std::cout << kReplayHelp;
+      return 0;
+    } else if (a == "--out") {
+      if (!v || v->empty() || v->front() == '-') return bad_input("--out needs a file name");
+      out = *v, take();
+    } else if (a == "--set") {
+      if (!v || v->find('=') == std::string::npos || v->front() == '=')
+        return bad_input("--set needs NAME=VALUE" + (v ? " (got '" + *v + "')" : std::string()));
+      replay.sets.push_back(*v), take();
+    } else if (a == "--scenario-dir") {
+      if (!v || v->empty()) return bad_input("--scenario-dir needs a directory");
+      replay.scenario_dir = *v, take();
+    } else if (a == "--compress") {
+      char* end = nullptr;
+      const long level = v ? std::strtol(v->c_str(), &end, 10) : 0;
+      if (!v || *end != '\0' || level < 1 || level > 9) return bad_input("--compress needs a level from 1 to 9");
+      compression = static_cast<int>(level), take();
+    } else if (a == "--quiet") {
+      quiet = true;
+    } else if (a.rfind("-", 0) == 0) {
+      return bad_input("unknown option '" + a + "' (graspsim replay --help)");
+    } else if (trace.empty()) {
+      trace = a;
+    } else {
+      return bad_input("one trace at a time (got '" + trace + "' and '" + a + "')");
+    }
+  }
+  if (trace.empty()) return bad_input("replay needs a trace file (graspsim replay --help)");
+  if (out.empty()) out = default_out(trace);
+  std::error_code ec;
+  if (std::filesystem::equivalent(trace, out, ec) || std::filesystem::absolute(trace) == std::filesystem::absolute(out)) {
+    return bad_input("--out " + out + " is the trace being replayed: it would be written over");
+  }
+
+  app::ReplayPlan plan;
+  try {
+    plan = app::load_replay(trace, replay);
+  } catch (const app::ReplayError& e) {
+    return bad_input(std::string("replay: ") + e.what());
+  }
+  for (const std::string& note : plan.notes) std::cerr << "graspsim: replay: " << note << "\n";
+
+  app::RunOptions options = plan.run_options(out);
+  options.compression = compression;
+  options.interrupt = interrupt;
+  app::RunResult result;
+  try {
+    result = app::run_scenario(*plan.scenario, options);
+  } catch (const recordings::TraceError& e) {
+    return bad_input(std::string("cannot write the trace: ") + e.what());
+  }
+
+  const auto& scenario = *plan.scenario;
+  if (!quiet) {
+    std::printf("graspsim replay of %s: %s (recorded from %s, %s)\n", trace.c_str(), scenario.name().c_str(),
+                plan.scenario_path.c_str(), plan.scenario_source_hash.c_str());
+    if (plan.what_if) {
+      std::string sets;
+      for (const std::string& s : replay.sets) sets += (sets.empty() ? "" : ", ") + s;
+      std::printf("  what if     %s (same recorded hand motion)\n", sets.c_str());
+    }
+    std::printf("  simulated   %.3f s: %lld servo, %lld haptic, %lld physics ticks\n", result.simulated,
+                static_cast<long long>(result.servo_ticks), static_cast<long long>(result.haptic_ticks),
+                static_cast<long long>(result.physics_ticks));
+    std::printf("  trace       %s\n", result.trace_path.c_str());
+  }
+  if (!result.error.empty()) {
+    std::fprintf(stderr, "graspsim: the replay stopped early: %s\n  (the trace keeps every tick up to there)\n",
+                 result.error.c_str());
+  }
+
+  // The new trace against the recording, bit for bit, on the ticks both hold.
+  bool reproduced = false;
+  try {
+    recordings::CompareOptions bitwise;
+    bitwise.bitwise = true;
+    const recordings::CompareResult c = recordings::compare_traces(trace, result.trace_path, bitwise);
+    reproduced = c.same();
+    std::int64_t hashes = 0;
+    for (const auto& d : c.datasets)
+      if (d.path == "physics/state_hash") hashes = d.elements;
+    if (reproduced) {
+      if (!quiet)
+        std::printf("  reproduced  bit for bit: %zu datasets, state_hash equal at all %lld physics ticks\n",
+                    c.datasets.size(), static_cast<long long>(hashes));
+    } else {
+      const recordings::DatasetResult& d = c.datasets.front();   // the first to part
+      const recordings::ElementPoint& p = *d.first;
+      const std::string component = d.components.size() > 1 ? " " + d.components[p.component] : "";
+      std::printf("  %s %s tick %lld (t = %.9g s): %s%s%s %s%s (%.17g, replay %.17g); %lld of %zu datasets "
+                  "differ (graspsim compare %s %s)\n",
+                  plan.what_if ? "parts       from the recording at" : "DIFFERS     from the recording at",
+                  d.loop.c_str(), static_cast<long long>(p.tick), p.time, d.kind.c_str(),
+                  d.kind.empty() ? "" : " ", d.name.c_str(), d.quantity.c_str(), component.c_str(), p.a, p.b,
+                  static_cast<long long>(c.differing_datasets()), c.datasets.size(), trace.c_str(),
+                  result.trace_path.c_str());
+    }
+  } catch (const recordings::TraceError& e) {
+    std::fprintf(stderr, "graspsim: cannot compare the replay with the recording: %s\n", e.what());
+  }
+
+  int failed = 0;
+  if (!result.expectations.empty() && !quiet) std::printf("  expectations\n");
+  for (const auto& e : result.expectations) {
+    failed += !e.passed;
+    if (quiet && e.passed) continue;
+    std::printf("    %s  %s%s%s\n", e.passed ? "PASS" : "FAIL", e.what.c_str(), e.detail.empty() ? "" : ": ",
+                e.detail.c_str());
+  }
+  if (result.interrupted) return 130;
+  if (!result.error.empty()) return 2;
+  if (!plan.what_if && !reproduced) return 1;
+  return failed ? 1 : 0;
+}
+
+}  // namespace graspsim::cli
