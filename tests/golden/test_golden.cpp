@@ -67,6 +67,24 @@ void perturb(const std::string& file, const std::string& path, hsize_t row, hsiz
   H5Fclose(f);
 }
 
+// Replaces the root string attribute `name` (a golden "written elsewhere").
+void set_root_string(const std::string& file, const std::string& name, const std::string& value) {
+  const hid_t f = H5Fopen(file.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
+  REQUIRE(f >= 0);
+  const hid_t type = H5Tcopy(H5T_C_S1);
+  H5Tset_size(type, H5T_VARIABLE);
+  const hid_t space = H5Screate(H5S_SCALAR);
+  if (H5Aexists(f, name.c_str()) > 0) H5Adelete(f, name.c_str());
+  const hid_t a = H5Acreate2(f, name.c_str(), type, space, H5P_DEFAULT, H5P_DEFAULT);
+  REQUIRE(a >= 0);
+  const char* text = value.c_str();
+  REQUIRE(H5Awrite(a, type, &text) >= 0);
+  H5Aclose(a);
+  H5Sclose(space);
+  H5Tclose(type);
+  H5Fclose(f);
+}
+
 }  // namespace
 
 // Item 5. Each scenario reruns in process at its own rates (as `tools/bless` ran it) and its
@@ -136,7 +154,7 @@ TEST_CASE("a golden keeps every physics row and the servo and haptic rows at phy
 
 // The check can fail, and says where: one element of the golden moved by 1e-12 m at physics
 // row 100 (tick 6000, t = 2 s) is reported there, by quantity and component, with the command
-// that re-blesses.
+// that re-blesses and the toolchain and CPU differences that void the promise.
 TEST_CASE("a golden that differs by one element is reported at its tick with the bless command", "[golden]") {
   const std::string file = kSource + "/scenarios/two_finger_lift.lua";
   const std::string golden = golden::golden_path(kGoldenDir, file);
@@ -144,6 +162,9 @@ TEST_CASE("a golden that differs by one element is reported at its tick with the
   const std::string changed = kTmp + "/golden_changed.h5";
   fs::copy_file(golden, changed, fs::copy_options::overwrite_existing);
   perturb(changed, "/physics/objects/box/position", 100, 2, 1e-12);
+  // As if blessed with another toolchain on another machine: the message says so.
+  set_root_string(changed, "compiler", "clang 99");
+  set_root_string(changed, "golden_cpu", "Some Other CPU");
   const std::string fresh = kTmp + "/golden_changed_run.h5";
   REQUIRE(golden::run_for_golden(file, fresh).error.empty());
   const golden::GoldenCheck check = golden::check_against_golden(fresh, changed, file);
@@ -153,6 +174,26 @@ TEST_CASE("a golden that differs by one element is reported at its tick with the
   CHECK_THAT(check.message, Catch::Contains("first divergence at tick 6000 (t = 2.000000 s): "
                                             "physics/objects/box/position z"));
   CHECK_THAT(check.message, Catch::Contains("tools/bless scenarios/two_finger_lift.lua"));
+  CHECK_THAT(check.message, Catch::Contains("the golden's compiler was 'clang 99'"));
+  CHECK_THAT(check.message, Catch::Contains("blessed on CPU 'Some Other CPU'"));
+}
+
+// The bless command itself: a golden that matches is left alone (exit 0), --dry-run writes
+// nothing, a missing scenario or an unknown option is bad input (exit 2).
+TEST_CASE("tools/bless leaves a matching golden alone and refuses bad input", "[golden]") {
+  const std::string bless = GRASPSIM_BLESS;
+  const std::string golden = golden::golden_path(kGoldenDir, "two_finger_lift.lua");
+  const auto before = fs::last_write_time(golden);
+  const Outcome same = shell(bless + " --dry-run " + kSource + "/scenarios/two_finger_lift.lua");
+  INFO(same.output);
+  CHECK(same.status == 0);
+  CHECK_THAT(same.output, Catch::Contains("unchanged: bit-identical"));
+  CHECK(fs::last_write_time(golden) == before);
+  const Outcome missing = shell(bless + " " + kTmp + "/nowhere.lua");
+  CHECK(missing.status == 2);
+  CHECK_THAT(missing.output, Catch::Contains("no such scenario file"));
+  CHECK(shell(bless + " --frobnicate").status == 2);
+  CHECK(shell(bless).status == 2);
 }
 
 // Item 6, in one process: two runs give the same trace bit for bit and the same attributes
