@@ -1,0 +1,267 @@
+// Golden regressions (issue 4, item 5) and determinism (item 6): every scenario reruns and
+// matches its golden trace bit for bit; the same scenario gives the same trace in one process,
+// in two processes and from a Debug and a Release build. README.md, "Golden traces" and
+// "Determinism".
+#include <catch2/catch.hpp>
+#include <hdf5.h>
+#include <sys/wait.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "golden/golden.hpp"
+#include "graspsim/recordings/trace_reader.hpp"
+#include "graspsim/scripting/scenario.hpp"
+
+namespace fs = std::filesystem;
+using namespace graspsim;
+
+namespace {
+
+const std::string kSource = GRASPSIM_SOURCE_DIR;
+const std::string kGoldenDir = kSource + "/tests/golden";
+const std::string kTmp = GRASPSIM_TEST_TMP;
+
+std::vector<std::string> scenario_files() {
+  std::vector<std::string> files;
+  for (const auto& entry : fs::directory_iterator(kSource + "/scenarios"))
+    if (entry.path().extension() == ".lua") files.push_back(entry.path().string());
+  std::sort(files.begin(), files.end());
+  return files;
+}
+
+struct Outcome {
+  int status;
+  std::string output;
+};
+
+Outcome shell(const std::string& command) {
+  FILE* pipe = popen((command + " 2>&1").c_str(), "r");
+  REQUIRE(pipe);
+  std::string out;
+  char buf[4096];
+  while (std::size_t n = std::fread(buf, 1, sizeof buf, pipe)) out.append(buf, n);
+  const int raw = pclose(pipe);
+  return Outcome{WIFEXITED(raw) ? WEXITSTATUS(raw) : -1, out};
+}
+
+// Adds `delta` to element (row, component) of a float64 dataset, in place.
+void perturb(const std::string& file, const std::string& path, hsize_t row, hsize_t component, double delta) {
+  const hid_t f = H5Fopen(file.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
+  REQUIRE(f >= 0);
+  const hid_t d = H5Dopen2(f, path.c_str(), H5P_DEFAULT);
+  REQUIRE(d >= 0);
+  const hid_t space = H5Dget_space(d);
+  hsize_t dims[2] = {0, 1};
+  H5Sget_simple_extent_dims(space, dims, nullptr);
+  std::vector<double> values(dims[0] * dims[1]);
+  REQUIRE(H5Dread(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, values.data()) >= 0);
+  values.at(row * dims[1] + component) += delta;
+  REQUIRE(H5Dwrite(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, values.data()) >= 0);
+  H5Sclose(space);
+  H5Dclose(d);
+  H5Fclose(f);
+}
+
+// Replaces the root string attribute `name` (a golden "written elsewhere").
+void set_root_string(const std::string& file, const std::string& name, const std::string& value) {
+  const hid_t f = H5Fopen(file.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
+  REQUIRE(f >= 0);
+  const hid_t type = H5Tcopy(H5T_C_S1);
+  H5Tset_size(type, H5T_VARIABLE);
+  const hid_t space = H5Screate(H5S_SCALAR);
+  if (H5Aexists(f, name.c_str()) > 0) H5Adelete(f, name.c_str());
+  const hid_t a = H5Acreate2(f, name.c_str(), type, space, H5P_DEFAULT, H5P_DEFAULT);
+  REQUIRE(a >= 0);
+  const char* text = value.c_str();
+  REQUIRE(H5Awrite(a, type, &text) >= 0);
+  H5Aclose(a);
+  H5Sclose(space);
+  H5Tclose(type);
+  H5Fclose(f);
+}
+
+}  // namespace
+
+// Item 5. Each scenario reruns in process at its own rates (as `tools/bless` ran it) and its
+// full trace is compared bitwise with the golden through recordings::compare_traces: every
+// golden row (all /physics rows with the state hash, /servo and /haptic at physics ticks) must
+// find its tick and be bit-identical. A failure names the first diverging tick and quantity and
+// the command that re-blesses; a scenario without a golden fails with that command.
+TEST_CASE("every scenario in scenarios/ reruns bit-identical to its golden trace", "[golden]") {
+  const auto files = scenario_files();
+  REQUIRE(files.size() >= 13);
+  for (const std::string& file : files) {
+    const std::string golden = golden::golden_path(kGoldenDir, file);
+    const std::string fresh = kTmp + "/golden_run_" + fs::path(file).stem().string() + ".h5";
+    INFO(file);
+    if (!fs::exists(golden)) {
+      FAIL_CHECK("no golden trace " << golden << " for " << file << ": bless one with "
+                                    << golden::bless_command(file) << " and commit it");
+      continue;
+    }
+    const app::RunResult run = golden::run_for_golden(file, fresh);
+    INFO("run error: " << run.error);
+    CHECK(run.error.empty());
+    const golden::GoldenCheck check = golden::check_against_golden(fresh, golden, file);
+    INFO(check.message);
+    CHECK(check.same);
+    // The golden holds every physics tick of the run: the state hash proves the whole State.
+    CHECK(check.result.loops.at(2).loop == "physics");
+    CHECK(check.result.loops.at(2).matched == run.physics_ticks);
+  }
+}
+
+// What a golden keeps: the decimation rule of README.md, checked on a fresh trace.
+TEST_CASE("a golden keeps every physics row and the servo and haptic rows at physics ticks", "[golden]") {
+  const std::string file = kSource + "/scenarios/two_finger_lift.lua";
+  const std::string full = kTmp + "/golden_decimate_full.h5";
+  const std::string small = kTmp + "/golden_decimate_small.h5";
+  const app::RunResult run = golden::run_for_golden(file, full);
+  REQUIRE(run.error.empty());
+  golden::decimate_trace(full, small);
+  // 3000 / 50 Hz: a physics tick every 60 servo ticks, from tick 0.
+  const auto servo = recordings::read_dataset(small, "/servo/tick").values;
+  const auto haptic = recordings::read_dataset(small, "/haptic/tick").values;
+  const auto physics = recordings::read_dataset(small, "/physics/tick").values;
+  CHECK(servo.size() == static_cast<std::size_t>(run.physics_ticks));
+  CHECK(servo == physics);
+  CHECK(haptic == physics);
+  CHECK(physics == recordings::read_dataset(full, "/physics/tick").values);
+  for (double t : servo) CHECK(std::fmod(t, 60.0) == 0.0);
+  // Same data where ticks meet, every golden row matched; attributes copied, plus `golden`.
+  recordings::CompareOptions options;
+  options.bitwise = true;
+  const auto result = recordings::compare_traces(full, small, options);
+  CHECK(result.same());
+  for (const auto& loop : result.loops) {
+    CHECK(loop.only_b == 0);
+    CHECK(loop.matched == loop.rows_b);
+  }
+  CHECK(result.loops.at(0).only_a == run.servo_ticks - run.physics_ticks);
+  CHECK(recordings::read_string_attribute(small, "/", "scenario_source") ==
+        recordings::read_string_attribute(full, "/", "scenario_source"));
+  CHECK(recordings::read_string_attribute(small, "/physics/objects/box/position", "units") == "m");
+  CHECK(recordings::read_string_attribute(small, "/haptic", "bodies") ==
+        recordings::read_string_attribute(full, "/haptic", "bodies"));
+  CHECK_THAT(recordings::read_string_attribute(small, "/", "golden"), Catch::Contains("multiples of 60"));
+  CHECK(fs::file_size(small) * 5 < fs::file_size(full));
+}
+
+// The check can fail, and says where: one element of the golden moved by 1e-12 m at physics
+// row 100 (tick 6000, t = 2 s) is reported there, by quantity and component, with the command
+// that re-blesses and the toolchain and CPU differences that void the promise.
+TEST_CASE("a golden that differs by one element is reported at its tick with the bless command", "[golden]") {
+  const std::string file = kSource + "/scenarios/two_finger_lift.lua";
+  const std::string golden = golden::golden_path(kGoldenDir, file);
+  REQUIRE(fs::exists(golden));
+  const std::string changed = kTmp + "/golden_changed.h5";
+  fs::copy_file(golden, changed, fs::copy_options::overwrite_existing);
+  perturb(changed, "/physics/objects/box/position", 100, 2, 1e-12);
+  // As if blessed with another toolchain on another machine: the message says so.
+  set_root_string(changed, "compiler", "clang 99");
+  set_root_string(changed, "golden_cpu", "Some Other CPU");
+  const std::string fresh = kTmp + "/golden_changed_run.h5";
+  REQUIRE(golden::run_for_golden(file, fresh).error.empty());
+  const golden::GoldenCheck check = golden::check_against_golden(fresh, changed, file);
+  INFO(check.message);
+  CHECK_FALSE(check.same);
+  CHECK(check.result.differing_datasets() == 1);
+  CHECK_THAT(check.message, Catch::Contains("first divergence at tick 6000 (t = 2.000000 s): "
+                                            "physics/objects/box/position z"));
+  CHECK_THAT(check.message, Catch::Contains("tools/bless scenarios/two_finger_lift.lua"));
+  CHECK_THAT(check.message, Catch::Contains("the golden's compiler was 'clang 99'"));
+  CHECK_THAT(check.message, Catch::Contains("blessed on CPU 'Some Other CPU'"));
+}
+
+// The bless command itself: a golden that matches is left alone (exit 0), --dry-run writes
+// nothing, a missing scenario or an unknown option is bad input (exit 2).
+TEST_CASE("tools/bless leaves a matching golden alone and refuses bad input", "[golden]") {
+  const std::string bless = GRASPSIM_BLESS;
+  const std::string golden = golden::golden_path(kGoldenDir, "two_finger_lift.lua");
+  const auto before = fs::last_write_time(golden);
+  const Outcome same = shell(bless + " --dry-run " + kSource + "/scenarios/two_finger_lift.lua");
+  INFO(same.output);
+  CHECK(same.status == 0);
+  CHECK_THAT(same.output, Catch::Contains("unchanged: bit-identical"));
+  CHECK(fs::last_write_time(golden) == before);
+  const Outcome missing = shell(bless + " " + kTmp + "/nowhere.lua");
+  CHECK(missing.status == 2);
+  CHECK_THAT(missing.output, Catch::Contains("no such scenario file"));
+  CHECK(shell(bless + " --frobnicate").status == 2);
+  CHECK(shell(bless).status == 2);
+}
+
+// Item 6, in one process: two runs give the same trace bit for bit and the same attributes
+// (none is wall-clock), also when the rows are written in other blocks (other flush points:
+// the flushes change where data lands in the file, never the data).
+TEST_CASE("repeated runs in one process give bit-identical traces and attributes", "[determinism]") {
+  for (const std::string name : {"pole_balance", "lift_and_place"}) {
+    const auto scenario = scripting::Scenario::load(kSource + "/scenarios/" + name + ".lua", {});
+    std::vector<std::string> traces;
+    for (const std::size_t block_rows : {std::size_t{1024}, std::size_t{1024}, std::size_t{37}}) {
+      app::RunOptions options;
+      options.block_rows = block_rows;
+      options.out = kTmp + "/determinism_" + name + "_" + std::to_string(traces.size()) + ".h5";
+      REQUIRE(app::run_scenario(scenario, options).error.empty());
+      traces.push_back(options.out);
+    }
+    recordings::CompareOptions options;
+    options.bitwise = true;
+    options.attributes = true;
+    options.all_ticks = true;
+    for (std::size_t i = 1; i < traces.size(); ++i) {
+      const auto result = recordings::compare_traces(traces[0], traces[i], options);
+      INFO(name << " run " << i << ": " << golden::divergence_summary(result));
+      CHECK(result.same());
+      CHECK(result.attributes.empty());
+    }
+  }
+}
+
+// Item 6, across processes: two `graspsim run` child processes, compared by `graspsim compare
+// --bitwise` (and a third with --compress 4: compression changes the bytes, not the values).
+TEST_CASE("two graspsim run processes give bit-identical traces", "[determinism]") {
+  const std::string cli = GRASPSIM_CLI;
+  const std::string scenario = kSource + "/scenarios/three_finger_rotate.lua";
+  const std::string a = kTmp + "/determinism_proc_a.h5", b = kTmp + "/determinism_proc_b.h5",
+                    c = kTmp + "/determinism_proc_c.h5";
+  REQUIRE(shell(cli + " run --quiet " + scenario + " --out " + a).status == 0);
+  REQUIRE(shell(cli + " run --quiet " + scenario + " --out " + b).status == 0);
+  REQUIRE(shell(cli + " run --quiet --compress 4 " + scenario + " --out " + c).status == 0);
+  const Outcome ab = shell(cli + " compare --bitwise --all-ticks --attributes " + a + " " + b);
+  INFO(ab.output);
+  CHECK(ab.status == 0);
+  const Outcome ac = shell(cli + " compare --bitwise --all-ticks " + a + " " + c);
+  INFO(ac.output);
+  CHECK(ac.status == 0);
+}
+
+#ifdef GRASPSIM_CLI_TWIN
+// Item 6, Debug against Release: the same source built at -O0 (Debug, Eigen's assertions on)
+// and -O2 (Release), both with -ffp-contract=off, give bit-identical traces on this machine.
+// The twin binary is built by tests/golden/CMakeLists.txt (ExternalProject) into build/debug.
+TEST_CASE("a Debug and a Release build give bit-identical traces", "[determinism]") {
+  const std::string cli = GRASPSIM_CLI, twin = GRASPSIM_CLI_TWIN;
+  REQUIRE(fs::exists(twin));
+  for (const std::string name : {"mesh_grasp", "lift_and_place"}) {
+    const std::string scenario = kSource + "/scenarios/" + name + ".lua";
+    const std::string a = kTmp + "/determinism_" + name + "_main.h5", b = kTmp + "/determinism_" + name + "_twin.h5";
+    REQUIRE(shell(cli + " run --quiet " + scenario + " --out " + a).status == 0);
+    REQUIRE(shell(twin + " run --quiet " + scenario + " --out " + b).status == 0);
+    // The two really are different builds.
+    const std::string flags_a = recordings::read_string_attribute(a, "/", "build_flags");
+    const std::string flags_b = recordings::read_string_attribute(b, "/", "build_flags");
+    INFO(flags_a << " | " << flags_b);
+    CHECK(flags_a != flags_b);
+    CHECK_THAT(flags_a + flags_b, Catch::Contains("Debug:") && Catch::Contains("Release:"));
+    const Outcome o = shell(cli + " compare --bitwise --all-ticks " + a + " " + b);
+    INFO(o.output);
+    CHECK(o.status == 0);
+  }
+}
+#endif

@@ -1,0 +1,62 @@
+// Golden traces (README.md, "Golden traces"): one small trace per scenario under
+// tests/golden/, written by `tools/bless` and checked by tests/golden/test_golden.cpp. Both go
+// through the same three steps: run the scenario at its own rates (a full trace), decimate it
+// into a golden-sized copy, compare with recordings::compare_traces, bitwise.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "app/run.hpp"
+#include "graspsim/recordings/trace_compare.hpp"
+
+namespace graspsim::golden {
+
+// The golden of `scenario_file` (scenarios/X.lua -> <golden_dir>/X.h5).
+std::string golden_path(const std::string& golden_dir, const std::string& scenario_file);
+
+// The command that re-blesses it, for messages: "tools/bless scenarios/X.lua".
+std::string bless_command(const std::string& scenario_file);
+
+// Runs the scenario as the golden test and `tools/bless` do: loaded with no override, at its
+// own rates and duration, full trace (every row, uncompressed) to `trace`.
+app::RunResult run_for_golden(const std::string& scenario_file, const std::string& trace);
+
+// How a full trace becomes a golden: every /physics row (with the state hash of the whole
+// State), and the /servo and /haptic rows whose tick is a multiple of `stride` servo ticks;
+// 0 means rate_servo / rate_physics, i.e. the rows at physics ticks. Shuffle + deflate at
+// `compression` (1..9). Root and dataset attributes are copied; the root gets `golden` (what
+// was kept) and `golden_cpu` (the CPU model it was blessed on).
+struct DecimateOptions {
+  std::int64_t stride = 0;   // servo ticks
+  int compression = 9;
+};
+
+// Writes the decimated copy of trace `in` to `out` (replacing it). Throws
+// recordings::TraceError naming the file and dataset on failure.
+void decimate_trace(const std::string& in, const std::string& out, const DecimateOptions& options = {});
+
+// The fresh run's trace compared with its golden, bitwise, and what to say about it.
+struct GoldenCheck {
+  recordings::CompareResult result;
+  bool same = false;       // bit-identical on every golden row, and every golden row matched
+  std::string message;     // why not (first divergence, what to run); empty when same
+};
+
+// Compares a fresh full trace `fresh` with `golden` (bitwise; each golden row must find its
+// tick in the fresh trace). Throws recordings::CompareInputError for unusable files.
+GoldenCheck check_against_golden(const std::string& fresh, const std::string& golden,
+                                 const std::string& scenario_file);
+
+// "first divergence at tick T (t = S s): physics/objects/box/position z: golden A, run B" and
+// up to `max_datasets` lines "path: max abs error E, max rel error R, N of M elements".
+// Then per loop the ticks in one trace only; `only_b` alone: rows only in B (a decimated golden
+// leaves most run rows unmatched, which is not news).
+std::string divergence_summary(const recordings::CompareResult& result, std::size_t max_datasets = 12,
+                               bool only_b = false);
+
+// The CPU model ("model name" of /proc/cpuinfo), "unknown" if not found.
+std::string cpu_model();
+
+}  // namespace graspsim::golden
