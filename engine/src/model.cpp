@@ -73,6 +73,7 @@ ContactPair contact_pair(const Material& a, const Material& b) {
   const auto series = [](double x, double y) {
     if (std::isinf(x)) return y;
     if (std::isinf(y)) return x;
+    if (x + y == 0.0) return 0.0;   // two zero springs or dampers in series: none (not 0 / 0)
     return x * y / (x + y);
   };
   return ContactPair{std::min(a.mu, b.mu), std::min(kinetic_mu(a), kinetic_mu(b)),
@@ -132,6 +133,11 @@ std::vector<std::string> stability_warnings(const Model& model) {
       if (std::isinf(pair.stiffness) || std::isinf(pair.damping)) {
         out.push_back(what + " are both rigid (infinite stiffness or damping): they pass through each other; "
                       "give one of them a finite material stiffness and damping to make them collide");
+        continue;
+      }
+      if (pa.shape.kind == ShapeKind::kMesh && pb.shape.kind == ShapeKind::kMesh) {
+        out.push_back(what + " are both non-convex meshes: mesh against mesh has no contact method yet, so they "
+                      "pass through each other; make one of them convex (shape = \"convex\") or another shape");
         continue;
       }
       const double reduced = pa.mass * pb.mass / (pa.mass + pb.mass);

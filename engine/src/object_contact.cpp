@@ -118,8 +118,51 @@ std::uint64_t combine(std::uint64_t h, std::uint64_t v) {
 
 bool polyhedral(const Shape& s) { return s.kind == ShapeKind::kBox || (s.kind == ShapeKind::kConvex && s.hull); }
 
-// A pair of bodies that can touch: both rigid means no finite penalty law.
-bool collides(const ContactPair& p) { return std::isfinite(p.stiffness) && std::isfinite(p.damping); }
+// A pair of bodies that can touch: both rigid means no finite penalty law, no stiffness no force.
+bool collides(const ContactPair& p) {
+  return std::isfinite(p.stiffness) && std::isfinite(p.damping) && p.stiffness > 0.0;
+}
+
+// The point of triangle (a, b, c) closest to p (Ericson, Real-Time Collision Detection, 5.1.5).
+Vec3 closest_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {
+  const Vec3 ab = b - a, ac = c - a, ap = p - a;
+  const double d1 = ab.dot(ap), d2 = ac.dot(ap);
+  if (d1 <= 0.0 && d2 <= 0.0) return a;
+  const Vec3 bp = p - b;
+  const double d3 = ab.dot(bp), d4 = ac.dot(bp);
+  if (d3 >= 0.0 && d4 <= d3) return b;
+  const double vc = d1 * d4 - d3 * d2;
+  if (vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0) return a + (d1 / (d1 - d3)) * ab;
+  const Vec3 cp = p - c;
+  const double d5 = ab.dot(cp), d6 = ac.dot(cp);
+  if (d6 >= 0.0 && d5 <= d6) return c;
+  const double vb = d5 * d2 - d1 * d6;
+  if (vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0) return a + (d2 / (d2 - d6)) * ac;
+  const double va = d3 * d6 - d5 * d4;
+  if (va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0) return b + ((d4 - d3) / ((d4 - d3) + (d5 - d6))) * (c - b);
+  const double denom = 1.0 / (va + vb + vc);
+  return a + ab * (vb * denom) + ac * (vc * denom);
+}
+
+// A cylinder as the 12-sided prism of its floor points (floor_point: rim vertex j of the lower
+// cap is k = j, of the upper k = 12 + j), so that it rests on a box or a convex body on a face
+// of points, as on the floor, and not on FCL's one point.
+ConvexPolyhedron cylinder_prism(const Shape& s) {
+  constexpr int n = kCylinderRimPoints;
+  TriangleMesh mesh;
+  bool rolling = false;
+  for (int k = 0; k < 2 * n; ++k) mesh.vertices.push_back(floor_point(s, Mat3::Identity(), k, rolling));
+  for (int i = 1; i + 1 < n; ++i) {
+    mesh.triangles.push_back({n, n + i, n + i + 1});   // top, counter-clockwise seen from above
+    mesh.triangles.push_back({0, i + 1, i});           // bottom, seen from below
+  }
+  for (int i = 0; i < n; ++i) {
+    const int j = (i + 1) % n;
+    mesh.triangles.push_back({i, j, n + j});
+    mesh.triangles.push_back({i, n + j, n + i});
+  }
+  return convex_polyhedron(mesh);
+}
 
 bool add_pair(fcl::CollisionObjectd* a, fcl::CollisionObjectd* b, void* data) {
   auto* out = static_cast<std::vector<std::pair<int, int>>*>(data);
@@ -136,6 +179,9 @@ struct BodyContacts::Impl {
     std::unique_ptr<fcl::CollisionObjectd> object;   // user data: body index + 1
     std::shared_ptr<const ConvexPolyhedron> hull;    // polyhedral shapes
     HullEdges edges;
+    std::shared_ptr<const TriangleMesh> mesh;        // kMesh
+    std::vector<Vec3> triangle_normals;              // 1, body frame, outward: kMesh
+    double sphere_radius = 0.0;                      // m: kSphere, else 0
   };
   std::vector<Body> bodies;
   fcl::DynamicAABBTreeCollisionManagerd broadphase;
@@ -144,6 +190,7 @@ struct BodyContacts::Impl {
   ManifoldScratch scratch;
   std::array<ManifoldPoint, kMaxPairPoints> found{};
   std::array<PairPointContact, kMaxPairPoints> next{};
+  std::array<Vec3, kMaxPairPoints> scratch_q{};      // m, mesh frame: sphere_mesh's closest points
   fcl::CollisionRequestd request;
   fcl::CollisionResultd result;
 
@@ -158,7 +205,7 @@ struct BodyContacts::Impl {
     broadphase.update();
   }
 
-  // The contact points of a < b into `found`.
+  // The contact points of a < b into `found`, normals from a towards b, depths > 0.
   int find(const State& state, int a, int b) {
     const BodyState& sa = state.bodies[a];
     const BodyState& sb = state.bodies[b];
@@ -166,17 +213,49 @@ struct BodyContacts::Impl {
       return manifold(bodies[a].edges, sa.position, sa.rotation, bodies[b].edges, sb.position, sb.rotation,
                       scratch, found.data(), kMaxPairPoints);
     }
+    const bool mesh_a = bodies[a].mesh != nullptr, mesh_b = bodies[b].mesh != nullptr;
+    if (mesh_a && mesh_b) return 0;   // no method yet: stability_warnings() says so
+    if (mesh_a && bodies[b].sphere_radius > 0.0) return sphere_mesh(a, sb.position, bodies[b].sphere_radius, false);
+    if (mesh_b && bodies[a].sphere_radius > 0.0) return sphere_mesh(b, sa.position, bodies[a].sphere_radius, true);
     result.clear();
     fcl::collide(bodies[a].object.get(), bodies[b].object.get(), request, result);
     const int n = std::min(static_cast<int>(result.numContacts()), kMaxPairPoints);
+    const fcl::CollisionGeometryd* geometry_a = bodies[a].object->collisionGeometry().get();
     for (int i = 0; i < n; ++i) {
       const fcl::Contactd& c = result.getContact(static_cast<std::size_t>(i));
       found[i].point = c.pos;
-      found[i].normal = c.normal.normalized();   // FCL: from o1 (a) to o2 (b)
-      found[i].depth = c.penetration_depth;
-      found[i].key = combine(combine(4, static_cast<std::uint64_t>(c.b1)), static_cast<std::uint64_t>(c.b2));
+      // FCL's sign conventions differ by pair kind and argument order (FCL 0.7: a mesh's contacts
+      // point from the mesh outwards whichever comes first, a box's against a mesh inwards, and
+      // the depth of sphere-triangle contacts is negative), so the sense is set here: against a
+      // mesh, along the touched triangle's outward normal (meshes are closed and oriented); between
+      // two convex shapes, along the line between their centres of mass, which lie on either side
+      // of the contact plane unless one is thinner than the overlap.
+      Vec3 nrm = c.normal.normalized();
+      double side = 0.0;   // > 0 when nrm points from a towards b (1 when along the triangle's)
+      if (mesh_a || mesh_b) {
+        const int m = mesh_a ? a : b;
+        const BodyState& sm = state.bodies[m];
+        const std::intptr_t tri = (c.o1 == bodies[m].object->collisionGeometry().get()) ? c.b1 : c.b2;
+        const Vec3 outward = sm.rotation * bodies[m].triangle_normals[static_cast<std::size_t>(tri)];
+        side = mesh_a ? nrm.dot(outward) : -nrm.dot(outward);
+      }
+      if (std::abs(side) < 0.5) {   // not mesh, or a triangle that FCL's normal crosses edge on
+        side = nrm.dot(sb.position - sa.position);
+      }
+      if (side < 0.0) nrm = -nrm;
+      found[i].normal = nrm;
+      found[i].depth = std::abs(c.penetration_depth);
+      const bool swapped = c.o1 != geometry_a;   // FCL may report the pair as (b, a)
+      const std::uint64_t fa = static_cast<std::uint64_t>(swapped ? c.b2 : c.b1);
+      const std::uint64_t fb = static_cast<std::uint64_t>(swapped ? c.b1 : c.b2);
+      found[i].key = combine(combine(4, fa), fb);
     }
-    // FCL's order is its traversal's: sort by key, then position, then rank equal keys.
+    return finish(n);
+  }
+
+  // FCL's contacts in `found[0, n)` in a fixed order: FCL's order is its traversal's, so sort by
+  // key, then position, then rank equal keys. Returns the count kept (depth > 0, at the front).
+  int finish(int n) {
     std::sort(found.begin(), found.begin() + n, [](const ManifoldPoint& p, const ManifoldPoint& q) {
       if (p.key != q.key) return p.key < q.key;
       for (int d = 0; d < 3; ++d) {
@@ -195,6 +274,69 @@ struct BodyContacts::Impl {
     }
     return kept;
   }
+
+  // Sphere (centre c, radius r, world) against mesh body m: for each triangle, its closest point
+  // q to the centre (Ericson, Real-Time Collision Detection 5.1.5); a contact where |c - q| < r,
+  // normal (c - q) / |c - q| out of the mesh, depth r - |c - q|. A centre on or behind a
+  // triangle's plane (sunk deeper than r) counts only over the triangle itself: normal the
+  // triangle's, depth r + its distance behind. Triangles that share the closest point (an edge or
+  // vertex, or a flat face cut into triangles) give it once, the first triangle's key.
+  int sphere_mesh(int m, const Vec3& centre_world, double r, bool mesh_is_b) {
+    const Body& body = bodies[m];
+    const fcl::Transform3d& tf = body.object->getTransform();
+    const Mat3 rot = tf.linear();
+    const Vec3 pos = tf.translation();
+    const Vec3 c = rot.transpose() * (centre_world - pos);   // m, mesh frame
+    const TriangleMesh& mesh = *body.mesh;
+    int n = 0;
+    for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
+      const auto& tri = mesh.triangles[t];
+      const Vec3& p0 = mesh.vertices[static_cast<std::size_t>(tri[0])];
+      const Vec3& tn = body.triangle_normals[t];
+      const double plane = tn.dot(c - p0);   // m: signed distance of the centre from the plane
+      if (plane >= r || plane <= -r) continue;
+      const Vec3 q = closest_on_triangle(c, p0, mesh.vertices[static_cast<std::size_t>(tri[1])],
+                                         mesh.vertices[static_cast<std::size_t>(tri[2])]);
+      const Vec3 d = c - q;
+      const double dist = d.norm();
+      if (dist >= r) continue;
+      Vec3 nrm;
+      double depth;
+      if (plane > 0.0 && dist > 1e-12 * r) {
+        nrm = d / dist;
+        depth = r - dist;
+      } else if ((d - plane * tn).squaredNorm() <= 1e-18 * r * r) {   // centre over the face, behind it
+        nrm = tn;
+        depth = r - plane;
+      } else {   // behind the plane and beside the triangle: the neighbouring face's contact
+        continue;
+      }
+      bool seen = false;
+      for (int i = 0; i < n; ++i) {
+        if ((scratch_q[i] - q).squaredNorm() <= 1e-24) {
+          seen = true;
+          break;
+        }
+      }
+      if (seen) continue;
+      int slot = n;
+      if (n < kMaxPairPoints) {
+        ++n;
+      } else {   // full: replace the shallowest if this one is deeper
+        slot = 0;
+        for (int i = 1; i < n; ++i) {
+          if (found[i].depth < found[slot].depth) slot = i;
+        }
+        if (depth <= found[slot].depth) continue;
+      }
+      scratch_q[slot] = q;
+      found[slot].point = pos + rot * (0.5 * (q + c - r * nrm));   // midway between the surfaces
+      found[slot].normal = mesh_is_b ? Vec3(-(rot * nrm)) : Vec3(rot * nrm);
+      found[slot].depth = depth;
+      found[slot].key = combine(5, static_cast<std::uint64_t>(t));
+    }
+    return n;
+  }
 };
 
 BodyContacts::BodyContacts(const Model& model) : impl_(std::make_unique<Impl>()) {
@@ -207,10 +349,22 @@ BodyContacts::BodyContacts(const Model& model) : impl_(std::make_unique<Impl>())
     body.object->setUserData(reinterpret_cast<void*>(static_cast<std::intptr_t>(i + 1)));
     if (shape.kind == ShapeKind::kBox) {
       body.hull = std::make_shared<const ConvexPolyhedron>(box_polyhedron(shape.half_extents));
+    } else if (shape.kind == ShapeKind::kCylinder) {
+      body.hull = std::make_shared<const ConvexPolyhedron>(cylinder_prism(shape));
     } else if (polyhedral(shape)) {
       body.hull = shape.hull;
     }
     if (body.hull) body.edges = hull_edges(*body.hull);
+    if (shape.kind == ShapeKind::kSphere) body.sphere_radius = shape.radius;
+    if (shape.kind == ShapeKind::kMesh) {
+      body.mesh = shape.mesh;
+      for (const auto& t : shape.mesh->triangles) {
+        const Vec3& p0 = shape.mesh->vertices[static_cast<std::size_t>(t[0])];
+        const Vec3 nrm = (shape.mesh->vertices[static_cast<std::size_t>(t[1])] - p0)
+                             .cross(shape.mesh->vertices[static_cast<std::size_t>(t[2])] - p0);
+        body.triangle_normals.push_back(nrm.normalized());
+      }
+    }
     objects.push_back(body.object.get());
     impl_->bodies.push_back(std::move(body));
   }

@@ -133,7 +133,7 @@ MeshFile read_obj(const std::string& path, const std::string& text) {
         const long index = parse_index(v, where);
         if (index == 0) fail_at(where, "vertex index 0 (OBJ counts from 1, or from -1 backwards)");
         if (index < 0) {
-          if (-index > static_cast<long>(points.size())) {
+          if (index < -static_cast<long>(points.size())) {   // not -index: overflows at LONG_MIN
             fail_at(where, "vertex index " + v + " is out of range (" + std::to_string(points.size()) +
                            " vertices so far)");
           }

@@ -240,6 +240,10 @@ TEST_CASE("mesh file errors name the file and line (OBJ, ASCII STL) or triangle 
   CHECK_THAT(error("bad_negative.obj", "v 0 0 0\nv 1 0 0\nf -1 -2 -3\n"),
              Contains(at + "bad_negative.obj:3: vertex index -3 is out of range (2 vertices so far)"));
   CHECK_THAT(error("zero.obj", "v 0 0 0\nf 0 1 1\n"), Contains(at + "zero.obj:2: vertex index 0"));
+  // The most negative long: its negation overflows (undefined behaviour), so the range test must
+  // not negate it.
+  CHECK_THAT(error("min_index.obj", "v 0 0 0\nf 1 2 -9223372036854775808\n"),
+             Contains(at + "min_index.obj:2: vertex index -9223372036854775808 is out of range (1 vertices so far)"));
   CHECK_THAT(error("few.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\n"),
              Contains(at + "few.obj: a closed mesh needs at least 4 triangles (got 2)"));
   CHECK_THAT(error("line.obj", std::string(kCubeObj) + "l 1 2\n"), Contains(at + "line.obj:15: unsupported statement 'l'"));
