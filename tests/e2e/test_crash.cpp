@@ -53,21 +53,26 @@ std::int64_t servo_rows(const std::string& file) {
   }
 }
 
-// Checks the cut file with h5py in SWMR mode: status, every table's datasets of equal length,
-// /servo/tick = 0..n-1. Prints n.
+// Checks the cut file with h5py in SWMR mode: status; every table's datasets of equal length up
+// to one block (a kill between two columns' appends of one block leaves them apart: under SWMR
+// each dataset's extent reaches the file on its own; seen once as /physics 1488 vs 1500 rows);
+// /servo/tick = 0..n-1 over the shortest servo column's n rows. Prints n.
 constexpr const char* kH5pyCheck = R"PY(
 import sys, h5py, numpy
 f = h5py.File(sys.argv[1], "r", swmr=True)
 status = f.attrs["status"]
 status = status.decode() if isinstance(status, bytes) else status
 assert status == "running", status
+shortest = {}
 for group in ("servo", "haptic", "physics"):
     lengths = set()
     f[group].visititems(lambda name, o: lengths.add(o.shape[0]) if isinstance(o, h5py.Dataset) else None)
-    assert len(lengths) == 1, (group, lengths)
-tick = f["servo/tick"][:]
-assert (tick == numpy.arange(len(tick))).all()
-print(len(tick))
+    assert max(lengths) - min(lengths) <= 1024, (group, lengths)
+    shortest[group] = min(lengths)
+n = shortest["servo"]
+tick = f["servo/tick"][:n]
+assert (tick == numpy.arange(n)).all()
+print(n)
 )PY";
 
 }  // namespace
@@ -153,7 +158,8 @@ TEST_CASE("a run killed with SIGKILL halfway leaves a readable, repairable trace
     const Outcome o = shell(std::string(kPython) + " " + script + " " + file);
     INFO(o.output);
     CHECK(o.status == 0);
-    CHECK(std::atoll(o.output.c_str()) == n);
+    CHECK(std::atoll(o.output.c_str()) <= n);        // the shortest servo column
+    CHECK(std::atoll(o.output.c_str()) > n - 1025);  // ... within one block of /servo/tick
   } else {
     WARN("python3-h5py is not installed (" << kPython << "): the h5py part was skipped");
   }
