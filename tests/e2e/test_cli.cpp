@@ -6,6 +6,7 @@
 #include <string>
 #include <sys/wait.h>
 
+#include "tests/support/shell.hpp"
 #include "graspsim/recordings/trace_reader.hpp"
 
 namespace {
@@ -14,21 +15,9 @@ const std::string kCli = GRASPSIM_CLI;
 const std::string kData = std::string(GRASPSIM_SOURCE_DIR) + "/tests/e2e/data/";
 const std::string kTmp = GRASPSIM_TEST_TMP;
 
-struct Outcome {
-  int status;           // exit status
-  std::string output;   // stdout and stderr together
-};
+using graspsim::test::Outcome;
 
-Outcome cli(const std::string& args) {
-  const std::string command = kCli + " " + args + " 2>&1";
-  FILE* pipe = popen(command.c_str(), "r");
-  REQUIRE(pipe);
-  std::string out;
-  char buf[4096];
-  while (std::size_t n = std::fread(buf, 1, sizeof buf, pipe)) out.append(buf, n);
-  const int raw = pclose(pipe);
-  return Outcome{WIFEXITED(raw) ? WEXITSTATUS(raw) : -1, out};
-}
+Outcome cli(const std::string& args) { return graspsim::test::shell(kCli + " " + args); }
 
 }  // namespace
 

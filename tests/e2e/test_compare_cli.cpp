@@ -11,6 +11,7 @@
 #include <fstream>
 #include <string>
 #include <sys/wait.h>
+#include "tests/support/shell.hpp"
 
 namespace {
 
@@ -18,20 +19,10 @@ const std::string kCli = GRASPSIM_CLI;
 const std::string kSource = GRASPSIM_SOURCE_DIR;
 const std::string kTmp = GRASPSIM_TEST_TMP;
 
-struct Outcome {
-  int status;           // exit status
-  std::string output;   // stdout (and stderr unless split)
-};
+using graspsim::test::Outcome;
 
 Outcome cli(const std::string& args, bool with_stderr = true) {
-  const std::string command = kCli + " " + args + (with_stderr ? " 2>&1" : " 2>/dev/null");
-  FILE* pipe = popen(command.c_str(), "r");
-  REQUIRE(pipe);
-  std::string out;
-  char buf[4096];
-  while (std::size_t n = std::fread(buf, 1, sizeof buf, pipe)) out.append(buf, n);
-  const int raw = pclose(pipe);
-  return Outcome{WIFEXITED(raw) ? WEXITSTATUS(raw) : -1, out};
+  return graspsim::test::shell(kCli + " " + args, with_stderr);
 }
 
 // Runs the two-finger lift (4 s) into `out`, with extra arguments.

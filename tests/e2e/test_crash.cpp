@@ -18,6 +18,7 @@
 #include "app/run.hpp"
 #include "graspsim/recordings/trace_reader.hpp"
 #include "graspsim/scripting/scenario.hpp"
+#include "tests/support/shell.hpp"
 
 using namespace graspsim;
 
@@ -28,20 +29,8 @@ const std::string kScenario = std::string(GRASPSIM_SOURCE_DIR) + "/scenarios/two
 const std::string kTmp = GRASPSIM_TEST_TMP;
 constexpr const char* kPython = "/usr/bin/python3";   // Debian's, with python3-h5py
 
-struct Outcome {
-  int status;
-  std::string output;   // stdout and stderr together
-};
-
-Outcome shell(const std::string& command) {
-  FILE* pipe = popen((command + " 2>&1").c_str(), "r");
-  REQUIRE(pipe);
-  std::string out;
-  char buf[4096];
-  while (std::size_t n = std::fread(buf, 1, sizeof buf, pipe)) out.append(buf, n);
-  const int raw = pclose(pipe);
-  return Outcome{WIFEXITED(raw) ? WEXITSTATUS(raw) : -1, out};
-}
+using graspsim::test::Outcome;
+using graspsim::test::shell;
 
 // Servo rows on disk now (our reader, as a SWMR reader while the run writes), -1 while the file
 // cannot be read yet (not created, or its layout not yet written).

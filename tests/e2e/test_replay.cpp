@@ -19,6 +19,7 @@
 #include "graspsim/recordings/trace_compare.hpp"
 #include "graspsim/recordings/trace_reader.hpp"
 #include "graspsim/scripting/scenario.hpp"
+#include "tests/support/shell.hpp"
 
 using namespace graspsim;
 
@@ -29,20 +30,9 @@ const std::string kSource = GRASPSIM_SOURCE_DIR;
 const std::string kScenarios = kSource + "/scenarios/";
 const std::string kTmp = GRASPSIM_TEST_TMP;
 
-struct Outcome {
-  int status;
-  std::string output;   // stdout and stderr
-};
+using graspsim::test::Outcome;
 
-Outcome cli(const std::string& args) {
-  FILE* pipe = popen((kCli + " " + args + " 2>&1").c_str(), "r");
-  REQUIRE(pipe);
-  std::string out;
-  char buf[4096];
-  while (std::size_t n = std::fread(buf, 1, sizeof buf, pipe)) out.append(buf, n);
-  const int raw = pclose(pipe);
-  return Outcome{WIFEXITED(raw) ? WEXITSTATUS(raw) : -1, out};
-}
+Outcome cli(const std::string& args) { return graspsim::test::shell(kCli + " " + args); }
 
 // Runs a scenario file (scripted fingers) into kTmp/<out>.h5, as `graspsim run` does.
 std::string record(const std::string& scenario_path, const std::vector<std::string>& sets, const std::string& out) {

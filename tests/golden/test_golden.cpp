@@ -16,6 +16,7 @@
 #include "golden/golden.hpp"
 #include "graspsim/recordings/trace_reader.hpp"
 #include "graspsim/scripting/scenario.hpp"
+#include "tests/support/shell.hpp"
 
 namespace fs = std::filesystem;
 using namespace graspsim;
@@ -34,20 +35,8 @@ std::vector<std::string> scenario_files() {
   return files;
 }
 
-struct Outcome {
-  int status;
-  std::string output;
-};
-
-Outcome shell(const std::string& command) {
-  FILE* pipe = popen((command + " 2>&1").c_str(), "r");
-  REQUIRE(pipe);
-  std::string out;
-  char buf[4096];
-  while (std::size_t n = std::fread(buf, 1, sizeof buf, pipe)) out.append(buf, n);
-  const int raw = pclose(pipe);
-  return Outcome{WIFEXITED(raw) ? WEXITSTATUS(raw) : -1, out};
-}
+using graspsim::test::Outcome;
+using graspsim::test::shell;
 
 // Adds `delta` to element (row, component) of a float64 dataset, in place.
 void perturb(const std::string& file, const std::string& path, hsize_t row, hsize_t component, double delta) {
