@@ -129,6 +129,7 @@ struct TraceTable::Impl {
   std::string file_path;
   std::string group_path;   // "/servo"
   TraceOptions options;
+  std::size_t block_rows = 0;    // rows buffered before a write, and rows per chunk
   FileState* file = nullptr;     // owned by the writer
   h5::Handle group;
   std::vector<Column> columns;
@@ -184,7 +185,7 @@ std::size_t TraceTable::add_column(const std::string& path, int width, DType dty
   const int rank = width == 1 ? 1 : 2;
   const hsize_t dims[2] = {0, static_cast<hsize_t>(width)};
   const hsize_t max_dims[2] = {H5S_UNLIMITED, static_cast<hsize_t>(width)};
-  const hsize_t chunk[2] = {static_cast<hsize_t>(t.options.block_rows),
+  const hsize_t chunk[2] = {static_cast<hsize_t>(t.block_rows),
                             static_cast<hsize_t>(width)};
   h5::Handle space = h5::checked(H5Screate_simple(rank, dims, max_dims), H5Sclose, where);
   h5::Handle dcpl = untimed(H5P_DATASET_CREATE, where);
@@ -211,7 +212,7 @@ double* TraceTable::append_row() {
   t.require_open();
   if (!t.started) {
     // Everything the table will ever need, allocated once.
-    const std::size_t block = t.options.block_rows;
+    const std::size_t block = t.block_rows;
     t.buffer.assign(block * t.row_width, 0.0);
     std::size_t need[5] = {0, 0, 0, 0, 0};
     for (const Column& c : t.columns) need[static_cast<int>(c.dtype)] = block * t.max_width;
@@ -224,7 +225,7 @@ double* TraceTable::append_row() {
     t.file->freeze();
     t.started = true;
   }
-  if (t.buffered == t.options.block_rows) {
+  if (t.buffered == t.block_rows) {
     h5::Quiet quiet;
     t.write_block();
     // Metadata too, so that a run cut short leaves a readable file up to this block.
@@ -386,7 +387,7 @@ TraceWriter::~TraceWriter() {
   }
 }
 
-TraceTable& TraceWriter::table(const std::string& group) {
+TraceTable& TraceWriter::table(const std::string& group, std::size_t block_rows) {
   Impl& w = *impl_;
   w.require_open();
   const std::string name = !group.empty() && group.front() == '/' ? group.substr(1) : group;
@@ -407,6 +408,7 @@ TraceTable& TraceWriter::table(const std::string& group) {
   impl->file_path = w.path;
   impl->group_path = "/" + name;
   impl->options = w.options;
+  impl->block_rows = block_rows > 0 ? block_rows : w.options.block_rows;
   impl->group = h5::checked(
       H5Gcreate2(w.root.get(), name.c_str(), lcpl.get(), gcpl.get(), H5P_DEFAULT), H5Gclose,
       where);
