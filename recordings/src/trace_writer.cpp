@@ -284,27 +284,35 @@ void TraceTable::Impl::write_column(Column& column) {
     throw TraceError(context(column.path) + ": cannot append rows: " + h5::last_error());
   };
 
-  // Gather the column out of the row-major buffer into its memory type.
+  // Gather the column out of the row-major buffer into its memory type: a plain copy for
+  // float64, the raw bits for uint64, a checked conversion for the signed integers.
   const void* data = nullptr;
   hid_t memory_type = H5T_NATIVE_DOUBLE;
   auto gather = [&](auto& out) {
-    for (std::size_t r = 0; r < n; ++r) {
-      const double* src = buffer.data() + r * row_width + column.offset;
-      for (std::size_t c = 0; c < width; ++c) {
-        const double value = src[c];
-        if (column.dtype == DType::kUInt64) {   // raw bits, see uint64_in_row
-          out[r * width + c] = static_cast<std::remove_reference_t<decltype(out[0])>>(
-              std::bit_cast<std::uint64_t>(value));
-          continue;
+    using T = std::remove_reference_t<decltype(out[0])>;
+    const double* src = buffer.data() + column.offset;
+    T* dst = out.data();
+    if constexpr (std::is_same_v<T, double>) {
+      for (std::size_t r = 0; r < n; ++r, src += row_width, dst += width) {
+        for (std::size_t c = 0; c < width; ++c) dst[c] = src[c];
+      }
+    } else if constexpr (std::is_same_v<T, std::uint64_t>) {   // raw bits, see uint64_in_row
+      for (std::size_t r = 0; r < n; ++r, src += row_width, dst += width) {
+        for (std::size_t c = 0; c < width; ++c) dst[c] = std::bit_cast<std::uint64_t>(src[c]);
+      }
+    } else {
+      for (std::size_t r = 0; r < n; ++r, src += row_width, dst += width) {
+        for (std::size_t c = 0; c < width; ++c) {
+          const double value = src[c];
+          if (!fits(value, column.dtype)) {
+            std::ostringstream message;
+            message.precision(17);
+            message << context(column.path) << ": row " << (written + static_cast<std::int64_t>(r))
+                    << " holds " << value << ", which is not an " << name_of(column.dtype);
+            throw TraceError(message.str());
+          }
+          dst[c] = static_cast<T>(value);
         }
-        if (column.dtype != DType::kFloat64 && !fits(value, column.dtype)) {
-          std::ostringstream message;
-          message.precision(17);
-          message << context(column.path) << ": row " << (written + static_cast<std::int64_t>(r))
-                  << " holds " << value << ", which is not an " << name_of(column.dtype);
-          throw TraceError(message.str());
-        }
-        out[r * width + c] = static_cast<std::remove_reference_t<decltype(out[0])>>(value);
       }
     }
     data = out.data();
@@ -323,6 +331,7 @@ void TraceTable::Impl::write_column(Column& column) {
   const hsize_t start[2] = {static_cast<hsize_t>(written), 0};
   const hsize_t count[2] = {n, width};
   if (H5Dset_extent(column.dataset.get(), new_dims) < 0) fail();
+
   h5::Handle file_space(H5Dget_space(column.dataset.get()), H5Sclose);
   if (!file_space.valid()) fail();
   if (H5Sselect_hyperslab(file_space.get(), H5S_SELECT_SET, start, nullptr, count, nullptr) < 0) {
