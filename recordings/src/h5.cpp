@@ -39,12 +39,23 @@ Handle open_single(hid_t object, const std::string& name, const std::string& con
 
 }  // namespace
 
+// Guards nest (every Handle::reset holds one, often inside another): only the outermost one
+// switches HDF5's printing off and back, since each switch costs about a microsecond and a block
+// write closes several handles (recordings/README.md "Cost").
+namespace {
+thread_local int quiet_depth = 0;
+}
+
 Quiet::Quiet() {
+  if (quiet_depth++ > 0) return;
   H5Eget_auto2(H5E_DEFAULT, &func_, &data_);
   H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
 }
 
-Quiet::~Quiet() { H5Eset_auto2(H5E_DEFAULT, func_, data_); }
+Quiet::~Quiet() {
+  if (--quiet_depth > 0) return;
+  H5Eset_auto2(H5E_DEFAULT, func_, data_);
+}
 
 std::string last_error() {
   std::string desc;

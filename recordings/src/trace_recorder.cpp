@@ -23,12 +23,20 @@ void put(double* row, std::size_t offset, const Vec3& v) {
   row[offset + 2] = v.z();
 }
 
+// Rows of a loop that runs every `divisor` servo ticks in `chunk_ticks` servo ticks (0: the
+// writer's default).
+std::size_t chunk_rows(std::int64_t chunk_ticks, std::int64_t divisor) {
+  if (chunk_ticks <= 0 || divisor <= 0) return 0;
+  return static_cast<std::size_t>((chunk_ticks + divisor - 1) / divisor);
+}
+
 }  // namespace
 
-TraceRecorder::TraceRecorder(TraceWriter& writer, const graspsim::Model& model)
-    : servo_(writer.table("servo")),
-      haptic_(writer.table("haptic")),
-      physics_(writer.table("physics")),
+TraceRecorder::TraceRecorder(TraceWriter& writer, const graspsim::Model& model,
+                             std::int64_t chunk_ticks)
+    : servo_(writer.table("servo", chunk_rows(chunk_ticks, 1))),
+      haptic_(writer.table("haptic", chunk_rows(chunk_ticks, divisors(model.rates).haptic))),
+      physics_(writer.table("physics", chunk_rows(chunk_ticks, divisors(model.rates).physics))),
       servo_rate_(static_cast<double>(model.rates.servo)) {
   for (const auto& f : model.fingers) check_name("finger", f.name);
   for (const auto& b : model.bodies) check_name("object", b.name);

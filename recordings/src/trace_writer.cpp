@@ -129,6 +129,7 @@ struct TraceTable::Impl {
   std::string file_path;
   std::string group_path;   // "/servo"
   TraceOptions options;
+  std::size_t block_rows = 0;    // rows buffered before a write, and rows per chunk
   FileState* file = nullptr;     // owned by the writer
   h5::Handle group;
   std::vector<Column> columns;
@@ -184,7 +185,7 @@ std::size_t TraceTable::add_column(const std::string& path, int width, DType dty
   const int rank = width == 1 ? 1 : 2;
   const hsize_t dims[2] = {0, static_cast<hsize_t>(width)};
   const hsize_t max_dims[2] = {H5S_UNLIMITED, static_cast<hsize_t>(width)};
-  const hsize_t chunk[2] = {static_cast<hsize_t>(t.options.block_rows),
+  const hsize_t chunk[2] = {static_cast<hsize_t>(t.block_rows),
                             static_cast<hsize_t>(width)};
   h5::Handle space = h5::checked(H5Screate_simple(rank, dims, max_dims), H5Sclose, where);
   h5::Handle dcpl = untimed(H5P_DATASET_CREATE, where);
@@ -211,7 +212,7 @@ double* TraceTable::append_row() {
   t.require_open();
   if (!t.started) {
     // Everything the table will ever need, allocated once.
-    const std::size_t block = t.options.block_rows;
+    const std::size_t block = t.block_rows;
     t.buffer.assign(block * t.row_width, 0.0);
     std::size_t need[5] = {0, 0, 0, 0, 0};
     for (const Column& c : t.columns) need[static_cast<int>(c.dtype)] = block * t.max_width;
@@ -224,7 +225,7 @@ double* TraceTable::append_row() {
     t.file->freeze();
     t.started = true;
   }
-  if (t.buffered == t.options.block_rows) {
+  if (t.buffered == t.block_rows) {
     h5::Quiet quiet;
     t.write_block();
     // Metadata too, so that a run cut short leaves a readable file up to this block.
@@ -283,27 +284,35 @@ void TraceTable::Impl::write_column(Column& column) {
     throw TraceError(context(column.path) + ": cannot append rows: " + h5::last_error());
   };
 
-  // Gather the column out of the row-major buffer into its memory type.
+  // Gather the column out of the row-major buffer into its memory type: a plain copy for
+  // float64, the raw bits for uint64, a checked conversion for the signed integers.
   const void* data = nullptr;
   hid_t memory_type = H5T_NATIVE_DOUBLE;
   auto gather = [&](auto& out) {
-    for (std::size_t r = 0; r < n; ++r) {
-      const double* src = buffer.data() + r * row_width + column.offset;
-      for (std::size_t c = 0; c < width; ++c) {
-        const double value = src[c];
-        if (column.dtype == DType::kUInt64) {   // raw bits, see uint64_in_row
-          out[r * width + c] = static_cast<std::remove_reference_t<decltype(out[0])>>(
-              std::bit_cast<std::uint64_t>(value));
-          continue;
+    using T = std::remove_reference_t<decltype(out[0])>;
+    const double* src = buffer.data() + column.offset;
+    T* dst = out.data();
+    if constexpr (std::is_same_v<T, double>) {
+      for (std::size_t r = 0; r < n; ++r, src += row_width, dst += width) {
+        for (std::size_t c = 0; c < width; ++c) dst[c] = src[c];
+      }
+    } else if constexpr (std::is_same_v<T, std::uint64_t>) {   // raw bits, see uint64_in_row
+      for (std::size_t r = 0; r < n; ++r, src += row_width, dst += width) {
+        for (std::size_t c = 0; c < width; ++c) dst[c] = std::bit_cast<std::uint64_t>(src[c]);
+      }
+    } else {
+      for (std::size_t r = 0; r < n; ++r, src += row_width, dst += width) {
+        for (std::size_t c = 0; c < width; ++c) {
+          const double value = src[c];
+          if (!fits(value, column.dtype)) {
+            std::ostringstream message;
+            message.precision(17);
+            message << context(column.path) << ": row " << (written + static_cast<std::int64_t>(r))
+                    << " holds " << value << ", which is not an " << name_of(column.dtype);
+            throw TraceError(message.str());
+          }
+          dst[c] = static_cast<T>(value);
         }
-        if (column.dtype != DType::kFloat64 && !fits(value, column.dtype)) {
-          std::ostringstream message;
-          message.precision(17);
-          message << context(column.path) << ": row " << (written + static_cast<std::int64_t>(r))
-                  << " holds " << value << ", which is not an " << name_of(column.dtype);
-          throw TraceError(message.str());
-        }
-        out[r * width + c] = static_cast<std::remove_reference_t<decltype(out[0])>>(value);
       }
     }
     data = out.data();
@@ -322,6 +331,7 @@ void TraceTable::Impl::write_column(Column& column) {
   const hsize_t start[2] = {static_cast<hsize_t>(written), 0};
   const hsize_t count[2] = {n, width};
   if (H5Dset_extent(column.dataset.get(), new_dims) < 0) fail();
+
   h5::Handle file_space(H5Dget_space(column.dataset.get()), H5Sclose);
   if (!file_space.valid()) fail();
   if (H5Sselect_hyperslab(file_space.get(), H5S_SELECT_SET, start, nullptr, count, nullptr) < 0) {
@@ -386,7 +396,7 @@ TraceWriter::~TraceWriter() {
   }
 }
 
-TraceTable& TraceWriter::table(const std::string& group) {
+TraceTable& TraceWriter::table(const std::string& group, std::size_t block_rows) {
   Impl& w = *impl_;
   w.require_open();
   const std::string name = !group.empty() && group.front() == '/' ? group.substr(1) : group;
@@ -407,6 +417,7 @@ TraceTable& TraceWriter::table(const std::string& group) {
   impl->file_path = w.path;
   impl->group_path = "/" + name;
   impl->options = w.options;
+  impl->block_rows = block_rows > 0 ? block_rows : w.options.block_rows;
   impl->group = h5::checked(
       H5Gcreate2(w.root.get(), name.c_str(), lcpl.get(), gcpl.get(), H5P_DEFAULT), H5Gclose,
       where);

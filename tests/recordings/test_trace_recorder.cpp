@@ -1,6 +1,7 @@
 // Tests of TraceRecorder: the engine's tick records land in /servo, /haptic and /physics with
 // the documented names, units, row counts and exact values, without allocating.
 #include <catch2/catch.hpp>
+#include <hdf5.h>
 
 #include <atomic>
 #include <bit>
@@ -163,6 +164,53 @@ void check(const std::string& file, const std::string& path, std::vector<std::si
 }
 
 }  // namespace
+
+// chunk_ticks: each table's chunk covers that many servo ticks of its loop, rounded up. At
+// 60/12/6 Hz (haptic every 5 servo ticks, physics every 10), 25 ticks = 25 /servo rows,
+// 5 /haptic rows and ceil(2.5) = 3 /physics rows. Flushed every 25 ticks as the runner does, the
+// tick columns still hold every tick of each loop, in order.
+TEST_CASE("the recorder sizes each table's chunk to chunk_ticks servo ticks", "[trace_recorder]") {
+  const std::string file = tmp_path("recorder_chunks.h5");
+  {
+    TraceWriter writer(file, TraceOptions{7, 0});
+    TraceRecorder recorder(writer, small_model(), 25);
+    TickRecord rec = blank_record();
+    Input input = blank_input();
+    State state = blank_state();
+    std::vector<Vec3> rendered(2);
+    for (std::int64_t tick = 0; tick < 60; ++tick) {
+      fill(rec, rendered, tick);
+      fill_input(input, tick);
+      fill_state(state, tick);
+      recorder.record(rec, rendered, input, state);
+      if ((tick + 1) % 25 == 0) writer.flush();
+    }
+    writer.close("complete");
+  }
+  const auto chunk_rows = [&](const std::string& path) {
+    const hid_t f = H5Fopen(file.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+    const hid_t d = H5Dopen2(f, path.c_str(), H5P_DEFAULT);
+    const hid_t plist = H5Dget_create_plist(d);
+    hsize_t dims[2] = {0, 0};
+    const int rank = H5Pget_chunk(plist, 2, dims);
+    H5Pclose(plist);
+    H5Dclose(d);
+    H5Fclose(f);
+    return rank >= 1 ? static_cast<std::int64_t>(dims[0]) : -1;
+  };
+  CHECK(chunk_rows("/servo/tick") == 25);
+  CHECK(chunk_rows("/servo/fingers/thumb/hip") == 25);
+  CHECK(chunk_rows("/haptic/tick") == 5);
+  CHECK(chunk_rows("/physics/tick") == 3);
+  CHECK(chunk_rows("/physics/state_hash") == 3);
+  for (const auto& [path, step] : {std::pair{std::string("/servo/tick"), 1},
+                                   std::pair{std::string("/haptic/tick"), 5},
+                                   std::pair{std::string("/physics/tick"), 10}}) {
+    std::vector<double> expected;
+    for (int t = 0; t < 60; t += step) expected.push_back(t);
+    CHECK(read_dataset(file, path).values == expected);
+  }
+}
 
 // 60 servo ticks at 60/12/6 Hz give 60 /servo rows, 12 /haptic rows (ticks 0, 5, ..., 55) and
 // 6 /physics rows (0, 10, ..., 50); every field lands in its documented dataset with its units,

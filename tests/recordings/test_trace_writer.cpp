@@ -230,6 +230,42 @@ TEST_CASE("datasets are chunked by block_rows and unlimited along rows", "[trace
   CHECK(four.max_dims == std::vector<hsize_t>{H5S_UNLIMITED, 4});
 }
 
+// TraceWriter::table(group, block_rows) gives that table its own block and chunk (the runner
+// sizes each table to one flush interval of its loop); 0 keeps TraceOptions::block_rows. The
+// block is written when it is full: after 5 rows of a 5-row table, not before.
+TEST_CASE("a table's own block_rows sets its chunk and when its block is written",
+          "[trace_writer]") {
+  const std::string file = tmp_path("table_chunks.h5");
+  {
+    TraceWriter writer(file, TraceOptions{16, 0});
+    TraceTable& a = writer.table("a", 5);
+    TraceTable& b = writer.table("b");
+    a.add_column("x", 3, DType::kFloat64, "m");
+    b.add_column("x", 1, DType::kFloat64, "m");
+    CHECK(&writer.table("a", 7) == &a);   // an existing table keeps its block
+    for (int r = 0; r < 5; ++r) {
+      double* row = a.append_row();
+      row[0] = r, row[1] = r + 0.5, row[2] = -r;
+    }
+    CHECK(read_dataset(file, "/a/x").shape.at(0) == 0);
+    a.append_row()[0] = 5;   // the sixth row writes the full block of five
+    a.append_row()[0] = 6;
+    CHECK(read_dataset(file, "/a/x").shape.at(0) == 5);
+    writer.close("complete");
+  }
+  CHECK(layout_of(file, "/a/x").chunk == std::vector<hsize_t>{5, 3});
+  CHECK(layout_of(file, "/b/x").chunk == std::vector<hsize_t>{16});
+  const Dataset a = read_dataset(file, "/a/x");
+  REQUIRE(a.shape == std::vector<std::size_t>{7, 3});
+  for (int r = 0; r < 5; ++r) {
+    CHECK(a.values[3 * r] == r);
+    CHECK(a.values[3 * r + 1] == r + 0.5);
+    CHECK(a.values[3 * r + 2] == -r);
+  }
+  CHECK(a.values[15] == 5);
+  CHECK(a.values[18] == 6);
+}
+
 // A run that records nothing still has every declared dataset, with 0 rows and its units.
 TEST_CASE("a table with zero rows still has its datasets, with shape (0, ...)",
           "[trace_writer]") {

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdio>
 #include <memory>
+#include <numeric>
 #include <optional>
 #include <sstream>
 
@@ -104,6 +105,19 @@ constexpr double kFlushSimulated = 0.25;   // s, simulated
 constexpr double kFlushWall = 0.9;         // s, wall (under 1 s, with the check interval's slack)
 constexpr std::int64_t kWallCheckTicks = 64;
 
+// Servo ticks between flushes on simulated time: the largest whole number of physics (and
+// haptic) periods within kFlushSimulated, so that every flush interval holds the same number of
+// rows of every loop and each table's chunk can be exactly one interval (each chunk is then
+// written once, whole: recordings/README.md "Cost"). 720 ticks (0.24 s) at 3000/500/50 Hz. If
+// one physics period is longer than kFlushSimulated: floor(kFlushSimulated * rate_servo).
+std::int64_t flush_interval_ticks(const Model& model) {
+  const std::int64_t limit =
+      std::max<std::int64_t>(1, static_cast<std::int64_t>(std::floor(kFlushSimulated * model.rates.servo)));
+  const Divisors d = divisors(model.rates);
+  const std::int64_t period = std::lcm(d.haptic, d.physics);
+  return period <= limit ? limit / period * period : limit;
+}
+
 }  // namespace
 
 bool RunResult::passed() const {
@@ -117,7 +131,7 @@ RunResult run_scenario(const scripting::Scenario& scenario, const RunOptions& op
   result.trace_path = options.out.empty() ? scenario.name() + ".h5" : options.out;
 
   recordings::TraceOptions trace_options;
-  trace_options.block_rows = options.block_rows;
+  if (options.block_rows > 0) trace_options.block_rows = options.block_rows;
   trace_options.compression = options.compression;
   // Without a trace (the logging benchmark's baseline) every attribute and row is skipped.
   std::optional<recordings::TraceWriter> writer_holder;
@@ -168,7 +182,8 @@ RunResult run_scenario(const scripting::Scenario& scenario, const RunOptions& op
 
     Simulation& sim = sim_holder.emplace(model);
     std::optional<recordings::TraceRecorder> recorder;
-    if (writer_holder) recorder.emplace(*writer_holder, model);
+    const std::int64_t flush_ticks = flush_interval_ticks(model);
+    if (writer_holder) recorder.emplace(*writer_holder, model, options.block_rows > 0 ? 0 : flush_ticks);
     Input input = make_input(model);
     TickRecord record = make_tick_record(model);
     std::vector<Vec3> rendered(model.fingers.size(), Vec3::Zero());
@@ -206,8 +221,6 @@ RunResult run_scenario(const scripting::Scenario& scenario, const RunOptions& op
 
     auto last_progress = start;
     auto last_flush = start;
-    const std::int64_t flush_ticks =
-        std::max<std::int64_t>(1, static_cast<std::int64_t>(std::floor(kFlushSimulated * model.rates.servo)));
     for (std::int64_t n = 0; n < run_ticks; ++n) {
       const double t = sim.time();
       for (std::size_t f = 0; f < devices.size(); ++f) {

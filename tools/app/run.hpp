@@ -17,7 +17,8 @@ namespace graspsim::app {
 
 struct RunOptions {
   std::string out;                  // trace path; "" means "<scenario name>.h5" in the working directory
-  std::size_t block_rows = 1024;    // trace rows buffered per loop before a write
+  std::size_t block_rows = 0;       // trace rows buffered per loop before a write, = rows per
+                                    // chunk; 0: one flush interval of that loop (run.cpp)
   int compression = 0;              // 0 none, 1..9 deflate level
   // Called every 0.25 s of wall time, once a run has taken 2 s, with the simulated time reached
   // (s); may be empty.

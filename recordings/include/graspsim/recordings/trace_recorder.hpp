@@ -18,8 +18,11 @@ class TraceRecorder {
  public:
   // Declares every table and column (and their attributes) in `writer`, which must outlive
   // the recorder. Throws std::invalid_argument for a finger or object name that cannot be an
-  // HDF5 group name (empty, ".", "..", or containing '/').
-  TraceRecorder(TraceWriter& writer, const graspsim::Model& model);
+  // HDF5 group name (empty, ".", "..", or containing '/'). `chunk_ticks` > 0: each table's
+  // chunk (and write block) covers that many servo ticks, i.e. chunk_ticks / (servo ticks per
+  // tick of its loop) rows, rounded up; a runner that flushes every chunk_ticks ticks then
+  // writes each chunk once, whole. 0: TraceOptions::block_rows rows for every table.
+  TraceRecorder(TraceWriter& writer, const graspsim::Model& model, std::int64_t chunk_ticks = 0);
 
   // Appends one /servo row, plus a /haptic row if rec.haptic_ran and a /physics row if
   // rec.physics_ran. `rendered` (one per finger): the force each device actually rendered after

@@ -67,7 +67,8 @@ class TraceTable {
 };
 
 struct TraceOptions {
-  std::size_t block_rows = 1024;   // rows: buffered per table before a write; also the chunk size
+  std::size_t block_rows = 1024;   // rows: buffered per table before a write; also the chunk
+                                   // size (per table: TraceWriter::table's block_rows)
   int compression = 0;             // 0 = none, 1..9 = deflate level
   // Crash safety (recordings/README.md): the newest file format and SWMR writing from the first
   // row on, so a process killed at any moment leaves every flushed row readable. false: the
@@ -89,8 +90,11 @@ class TraceWriter {
 
   // The table of group `group` ("servo" or "/servo"; may be nested, "a/b"), created on first
   // use (only before the file's first row); the same object afterwards. References stay valid
-  // until the writer is destroyed.
-  TraceTable& table(const std::string& group);
+  // until the writer is destroyed. `block_rows`: rows this table buffers before a write, which
+  // are also its rows per chunk (0: TraceOptions::block_rows); used only when the table is
+  // created. A writer that flushes every N rows of a table should give it N (a flush then writes
+  // whole chunks, each chunk once; recordings/README.md "Cost").
+  TraceTable& table(const std::string& group, std::size_t block_rows = 0);
   // Root attributes (replacing one of the same name). Before the file's first row they are
   // written at once; after it (SWMR cannot add attributes) they are kept and written by close().
   void set_attribute(const std::string& name, const std::string& value);
