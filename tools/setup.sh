@@ -6,15 +6,14 @@ graspsim_root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 graspsim_build=${GRASPSIM_BUILD_DIR:-$graspsim_root/build}
 
 # Everything graspsim needs from Debian 12, and nothing else. hdf5-tools gives h5dump and
-# h5ls for looking into traces; the plotting packages come with the plotting tool.
+# h5ls for looking into traces.
 graspsim_packages=(
   g++ make cmake pkg-config git
   libeigen3-dev libfcl-dev liblua5.4-dev libhdf5-dev catch2
   hdf5-tools
-  python3-h5py python3-matplotlib
+  python3-h5py python3-matplotlib   # tools/plot_trace.py; h5py also reads crash-cut traces in
+                                    # SWMR mode in tests/e2e/test_crash.cpp
 )
-# h5py (Debian's /usr/bin/python3) opens traces cut by a crash in SWMR mode: tests/e2e/test_crash.cpp.
-graspsim_packages+=(python3-h5py)
 
 graspsim_install_missing() {
   local missing=() p
