@@ -15,6 +15,7 @@
 #include "app/run.hpp"
 #include "cli/repair.hpp"
 #include "cli/replay.hpp"
+#include "cli/report.hpp"
 #include "graspsim_version.hpp"
 #include "graspsim/recordings/trace_writer.hpp"
 #include "graspsim/scripting/scenario.hpp"
@@ -23,10 +24,10 @@
 namespace {
 
 // Exit codes, as documented in --help.
-constexpr int kExitOk = 0;            // every expectation held
-constexpr int kExitFailed = 1;        // an expectation failed
-constexpr int kExitBadInput = 2;      // bad input: arguments, scenario, output path, script error
-constexpr int kExitInterrupted = 130; // Ctrl-C (128 + SIGINT)
+using graspsim::cli::kExitBadInput;
+using graspsim::cli::kExitFailed;
+using graspsim::cli::kExitInterrupted;
+using graspsim::cli::kExitOk;
 
 constexpr const char* kUsage =
     "usage: graspsim run SCENARIO.lua [--out FILE.h5] [--duration S] [--set NAME=VALUE]...\n"
@@ -246,14 +247,7 @@ int run_command(const std::vector<std::string>& args) {
     std::fprintf(stderr, "graspsim: the run stopped early: %s\n  (the trace keeps every tick up to there)\n",
                  result.error.c_str());
   }
-  int failed = 0;
-  if (!result.expectations.empty() && !quiet) std::printf("  expectations\n");
-  for (const auto& e : result.expectations) {
-    failed += !e.passed;
-    if (quiet && e.passed) continue;
-    std::printf("    %s  %s%s%s\n", e.passed ? "PASS" : "FAIL", e.what.c_str(), e.detail.empty() ? "" : ": ",
-                e.detail.c_str());
-  }
+  const int failed = graspsim::cli::print_expectations(result, quiet);
   if (result.interrupted) return kExitInterrupted;
   if (!result.error.empty()) return kExitBadInput;
   if (!quiet) {

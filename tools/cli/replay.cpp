@@ -10,6 +10,7 @@
 
 #include "app/replay.hpp"
 #include "app/run.hpp"
+#include "cli/report.hpp"
 #include "graspsim/recordings/trace_compare.hpp"
 
 namespace graspsim::cli {
@@ -51,7 +52,7 @@ constexpr const char* kReplayHelp =
 
 int bad_input(const std::string& message) {
   std::cerr << "graspsim: " << message << "\n";
-  return 2;
+  return kExitBadInput;
 }
 
 std::string default_out(const std::string& trace) {
@@ -171,18 +172,11 @@ int replay_command(const std::vector<std::string>& args, const std::atomic<bool>
     std::fprintf(stderr, "graspsim: cannot compare the replay with the recording: %s\n", e.what());
   }
 
-  int failed = 0;
-  if (!result.expectations.empty() && !quiet) std::printf("  expectations\n");
-  for (const auto& e : result.expectations) {
-    failed += !e.passed;
-    if (quiet && e.passed) continue;
-    std::printf("    %s  %s%s%s\n", e.passed ? "PASS" : "FAIL", e.what.c_str(), e.detail.empty() ? "" : ": ",
-                e.detail.c_str());
-  }
-  if (result.interrupted) return 130;
-  if (!result.error.empty()) return 2;
-  if (!plan.what_if && !reproduced) return 1;
-  return failed ? 1 : 0;
+  const int failed = print_expectations(result, quiet);
+  if (result.interrupted) return kExitInterrupted;
+  if (!result.error.empty()) return kExitBadInput;
+  if (!plan.what_if && !reproduced) return kExitFailed;
+  return failed ? kExitFailed : kExitOk;
 }
 
 }  // namespace graspsim::cli

@@ -1,0 +1,28 @@
+// What the run and replay commands share: exit codes and the expectations report.
+#pragma once
+
+#include <cstdio>
+
+#include "app/run.hpp"
+
+namespace graspsim::cli {
+
+constexpr int kExitOk = 0;            // every expectation held
+constexpr int kExitFailed = 1;        // an expectation failed
+constexpr int kExitBadInput = 2;      // bad input: arguments, scenario, output path, script error
+constexpr int kExitInterrupted = 130; // Ctrl-C (128 + SIGINT)
+
+// Prints the expectations of a run (only the failed ones when quiet); returns how many failed.
+inline int print_expectations(const app::RunResult& result, bool quiet) {
+  int failed = 0;
+  if (!result.expectations.empty() && !quiet) std::printf("  expectations\n");
+  for (const auto& e : result.expectations) {
+    failed += !e.passed;
+    if (quiet && e.passed) continue;
+    std::printf("    %s  %s%s%s\n", e.passed ? "PASS" : "FAIL", e.what.c_str(), e.detail.empty() ? "" : ": ",
+                e.detail.c_str());
+  }
+  return failed;
+}
+
+}  // namespace graspsim::cli
