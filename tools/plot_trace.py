@@ -31,7 +31,7 @@ import os
 import sys
 import tempfile
 
-SUPPORTED_SCHEMA = (1, 2)
+SUPPORTED_SCHEMA = (1, 2, 3)
 STATE_NAMES = {0: "free", 1: "stick", 2: "slip"}
 STATE_COLOURS = {0: "#e4e4e4", 1: "#4daf4a", 2: "#e41a1c"}
 
@@ -51,6 +51,7 @@ class Trace:
 
     def __init__(self, path, np, h5py):
         self.path = path
+        self.h5py = h5py
         self.label = os.path.basename(path)
         if not os.path.exists(path):
             raise BadInput(f"{path}: no such file")
@@ -75,12 +76,37 @@ class Trace:
         with f:
             self._read(f, np)
 
+    def split(self, f, name):
+        """(table dataset, member) for a column of a schema 3 table ("/physics/objects/b/position"
+        is member "objects/b/position" of compound dataset "/physics"), else (None, None)."""
+        table, _, member = name.lstrip("/").partition("/")
+        obj = f.get(table)
+        if isinstance(obj, self.h5py.Dataset) and obj.dtype.names is not None:
+            return obj, member
+        return None, None
+
+    def has(self, f, name):
+        table, member = self.split(f, name)
+        if table is not None:
+            return member in table.dtype.names
+        return name in f
+
+    def names_below(self, f, name):
+        """Next path components below `name`: member-name prefixes (schema 3) or group keys."""
+        table, member = self.split(f, name)
+        if table is not None:
+            prefix = member + "/"
+            return sorted({m[len(prefix):].split("/")[0] for m in table.dtype.names
+                           if m.startswith(prefix)})
+        return sorted(f[name].keys()) if name in f else []
+
     def need(self, f, name):
-        if name not in f:
+        if not self.has(f, name):
             raise BadInput(f"{self.path}: not a complete graspsim trace: missing dataset {name}")
         try:
-            return f[name][()]
-        except (OSError, TypeError) as e:
+            table, member = self.split(f, name)
+            return table[member] if table is not None else f[name][()]
+        except (OSError, TypeError, ValueError) as e:
             raise BadInput(f"{self.path}: cannot read dataset {name} ({e})")
 
     def _read(self, f, np):
@@ -101,7 +127,7 @@ class Trace:
 
         # Objects, in Model::bodies order (the /haptic attribute `bodies`), at physics ticks.
         self.t_physics = self.need(f, "/physics/time").astype(float)
-        present = list(f["/physics/objects"].keys()) if "/physics/objects" in f else []
+        present = self.names_below(f, "/physics/objects")
         order = text(f["/haptic"].attrs.get("bodies", "")).split("\n") if "/haptic" in f else []
         self.body_names = [n for n in order if n]
         self.objects = [n for n in self.body_names if n in present] + \
@@ -139,7 +165,7 @@ class Trace:
             self.finger_data[name] = d
 
     def _finger_order(self, f):
-        present = sorted(f["/haptic/fingers"].keys()) if "/haptic/fingers" in f else []
+        present = self.names_below(f, "/haptic/fingers")
         # Model::fingers order, when the runner's `devices` attribute ("name: kind" lines) has it.
         listed = [line.split(":")[0].strip() for line in text(f.attrs.get("devices", "")).splitlines()]
         ordered = [n for n in listed if n in present]

@@ -57,6 +57,16 @@ Quiet::~Quiet() {
   H5Eset_auto2(H5E_DEFAULT, func_, data_);
 }
 
+namespace {
+std::recursive_mutex& library_mutex() {
+  static std::recursive_mutex mutex;
+  return mutex;
+}
+}  // namespace
+
+Lock::Lock() { library_mutex().lock(); }
+Lock::~Lock() { library_mutex().unlock(); }
+
 std::string last_error() {
   std::string desc;
   H5Ewalk2(H5E_DEFAULT, H5E_WALK_UPWARD, take_innermost, &desc);
@@ -106,6 +116,18 @@ void write_string_attribute(hid_t object, const std::string& name, const std::st
   const htri_t exists = H5Aexists(object, name.c_str());
   check(exists, where);
   if (exists > 0) check(H5Adelete(object, name.c_str()), where);
+  Handle attribute = checked(
+      H5Acreate2(object, name.c_str(), type.get(), space.get(), H5P_DEFAULT, H5P_DEFAULT),
+      H5Aclose, where);
+  const char* text = value.c_str();
+  check(H5Awrite(attribute.get(), type.get(), &text), where);
+}
+
+void create_string_attribute(hid_t object, const std::string& name, const std::string& value,
+                             const std::string& context) {
+  const std::string where = context + ": cannot write attribute '" + name + "'";
+  Handle type = string_type();
+  Handle space = checked(H5Screate(H5S_SCALAR), H5Sclose, where);
   Handle attribute = checked(
       H5Acreate2(object, name.c_str(), type.get(), space.get(), H5P_DEFAULT, H5P_DEFAULT),
       H5Aclose, where);

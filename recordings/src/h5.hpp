@@ -5,6 +5,7 @@
 #include <hdf5.h>
 
 #include <cstdint>
+#include <mutex>
 #include <string>
 #include <utility>
 
@@ -23,6 +24,17 @@ class Quiet {
  private:
   H5E_auto2_t func_ = nullptr;
   void* data_ = nullptr;
+};
+
+// Debian's HDF5 is built without thread safety, and a trace may be written by a background
+// thread (TraceOptions::background) while the same process reads another trace: every entry
+// point of this module that calls HDF5 holds this lock (recursive: entry points nest).
+class Lock {
+ public:
+  Lock();
+  ~Lock();
+  Lock(const Lock&) = delete;
+  Lock& operator=(const Lock&) = delete;
 };
 
 // Why the last HDF5 call on this thread failed: the innermost message of the error stack, or
@@ -69,6 +81,9 @@ void check(herr_t status, const std::string& context);
 // A scalar string attribute (variable-length UTF-8), replacing one of the same name.
 void write_string_attribute(hid_t object, const std::string& name, const std::string& value,
                             const std::string& context);
+// The same for an attribute known not to exist yet (a new object): one look-up cheaper.
+void create_string_attribute(hid_t object, const std::string& name, const std::string& value,
+                             const std::string& context);
 // A scalar numeric attribute of HDF5 file type `file_type` from memory type `memory_type`.
 void write_scalar_attribute(hid_t object, const std::string& name, hid_t file_type,
                             hid_t memory_type, const void* value, const std::string& context);

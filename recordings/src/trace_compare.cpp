@@ -130,24 +130,57 @@ H5I_type_t object_type(hid_t loc, const std::string& path, const std::string& co
   return H5Iget_type(object.get());
 }
 
-// Top-level groups of the file, by name.
+// The names of the members of a compound dataset (a schema 3 table), or empty.
+std::vector<std::string> member_names(hid_t dataset, const std::string& context) {
+  h5::Handle type = h5::checked(H5Dget_type(dataset), H5Tclose, context);
+  std::vector<std::string> names;
+  if (H5Tget_class(type.get()) != H5T_COMPOUND) return names;
+  const int n = H5Tget_nmembers(type.get());
+  for (int k = 0; k < n; ++k) {
+    char* name = H5Tget_member_name(type.get(), static_cast<unsigned>(k));
+    if (name != nullptr) names.emplace_back(name);
+    H5free_memory(name);
+  }
+  return names;
+}
+
+bool is_table_dataset(hid_t loc, const std::string& path, const std::string& context) {
+  h5::Handle d = h5::checked(H5Dopen2(loc, path.c_str(), H5P_DEFAULT), H5Dclose,
+                             context + ": cannot open " + quoted(path));
+  return !member_names(d.get(), context).empty();
+}
+
+// Tables at the top of the file, by name: compound datasets (schema 3: one dataset per loop,
+// one member per column) or groups of datasets (schema 2 and before).
 std::vector<std::string> top_groups(const OpenTrace& t) {
   const std::string context = "trace " + quoted(t.name);
   std::vector<std::string> links, groups;
   hsize_t index = 0;
   h5::check(H5Literate(t.file.get(), H5_INDEX_NAME, H5_ITER_INC, &index, collect_link, &links),
             context + ": cannot list the root group");
-  for (const std::string& l : links)
-    if (object_type(t.file.get(), l, context) == H5I_GROUP) groups.push_back(l);
+  for (const std::string& l : links) {
+    const H5I_type_t type = object_type(t.file.get(), l, context);
+    if (type == H5I_GROUP || (type == H5I_DATASET && is_table_dataset(t.file.get(), l, context)))
+      groups.push_back(l);
+  }
   return groups;
 }
 
-// Every dataset below group `group` (recursively), as paths relative to it, by name.
+// Every column of table `group`, by name: the members of a compound table, or the datasets
+// below a group (recursively), as paths relative to it.
 std::vector<std::string> datasets_below(const OpenTrace& t, const std::string& group) {
   const std::string context = "trace " + quoted(t.name);
+  std::vector<std::string> out;
+  if (object_type(t.file.get(), group, context) == H5I_DATASET) {
+    h5::Handle d = h5::checked(H5Dopen2(t.file.get(), group.c_str(), H5P_DEFAULT), H5Dclose,
+                               context + ": cannot open " + quoted("/" + group));
+    out = member_names(d.get(), context);
+    std::sort(out.begin(), out.end());
+    return out;
+  }
   h5::Handle g = h5::checked(H5Gopen2(t.file.get(), group.c_str(), H5P_DEFAULT), H5Gclose,
                              context + ": cannot open group " + quoted("/" + group));
-  std::vector<std::string> links, out;
+  std::vector<std::string> links;
   h5::check(H5Lvisit(g.get(), H5_INDEX_NAME, H5_ITER_INC, collect_link, &links),
             context + ": cannot list group " + quoted("/" + group));
   for (const std::string& l : links)
@@ -161,7 +194,8 @@ enum class Kind { kFloat, kSigned, kUnsigned };
 // One open dataset of an aligned table: its kind, rows and width.
 struct Column {
   std::string file, path;   // path with a leading '/'
-  h5::Handle dataset;
+  h5::Handle dataset;       // the column's dataset, or its table's (member not empty)
+  std::string member;       // the column's member of a compound table, or "" 
   Kind kind = Kind::kFloat;
   std::int64_t rows = 0;
   std::size_t width = 1;
@@ -185,31 +219,65 @@ std::vector<std::string> split_order(const std::string& text) {
   return out;
 }
 
-Column open_column(const OpenTrace& t, const std::string& path) {
+// Opens column `path` of table `group` (path = "/" + group + "/" + name).
+Column open_column(const OpenTrace& t, const std::string& group, const std::string& name) {
   Column c;
   c.file = t.name;
-  c.path = path;
-  const std::string context = "trace " + quoted(t.name) + ", dataset " + quoted(path);
-  c.dataset = h5::checked(H5Dopen2(t.file.get(), path.c_str(), H5P_DEFAULT), H5Dclose,
-                          context + ": cannot open");
-  h5::Handle type = h5::checked(H5Dget_type(c.dataset.get()), H5Tclose, context);
+  c.path = "/" + group + "/" + name;
+  const std::string context = "trace " + quoted(t.name) + ", dataset " + quoted("/" + group + "/" + name);
+  h5::Handle type;
+  std::string units_key = "units", order_key = "order";
+  if (object_type(t.file.get(), group, context) == H5I_DATASET) {
+    // A member of a compound table: its attributes are the table's "<member>/<name>".
+    c.member = name;
+    units_key = name + "/units";
+    order_key = name + "/order";
+    c.dataset = h5::checked(H5Dopen2(t.file.get(), group.c_str(), H5P_DEFAULT), H5Dclose,
+                            context + ": cannot open");
+    h5::Handle row = h5::checked(H5Dget_type(c.dataset.get()), H5Tclose, context);
+    const int index = H5Tget_member_index(row.get(), name.c_str());
+    if (index < 0) fail(context + ": no such member");
+    h5::Handle member = h5::checked(H5Tget_member_type(row.get(), static_cast<unsigned>(index)),
+                                    H5Tclose, context);
+    if (H5Tget_class(member.get()) == H5T_ARRAY) {
+      if (H5Tget_array_ndims(member.get()) != 1) fail(context + ": not a 1-D array member");
+      hsize_t dims[1] = {0};
+      H5Tget_array_dims2(member.get(), dims);
+      c.width = static_cast<std::size_t>(dims[0]);
+      c.rank = 2;
+      type = h5::checked(H5Tget_super(member.get()), H5Tclose, context);
+    } else {
+      c.width = 1;
+      c.rank = 1;
+      type = std::move(member);
+    }
+    h5::Handle space = h5::checked(H5Dget_space(c.dataset.get()), H5Sclose, context);
+    if (H5Sget_simple_extent_ndims(space.get()) != 1) fail(context + ": its table is not 1-D");
+    hsize_t rows[1] = {0};
+    h5::check(H5Sget_simple_extent_dims(space.get(), rows, nullptr), context);
+    c.rows = static_cast<std::int64_t>(rows[0]);
+  } else {
+    c.dataset = h5::checked(H5Dopen2(t.file.get(), c.path.c_str(), H5P_DEFAULT), H5Dclose,
+                            context + ": cannot open");
+    type = h5::checked(H5Dget_type(c.dataset.get()), H5Tclose, context);
+    h5::Handle space = h5::checked(H5Dget_space(c.dataset.get()), H5Sclose, context);
+    c.rank = H5Sget_simple_extent_ndims(space.get());
+    if (c.rank != 1 && c.rank != 2)
+      fail(context + ": has " + std::to_string(c.rank) + " dimensions (a trace column has 1 or 2)");
+    hsize_t dims[2] = {0, 1};
+    h5::check(H5Sget_simple_extent_dims(space.get(), dims, nullptr), context);
+    c.rows = static_cast<std::int64_t>(dims[0]);
+    c.width = c.rank == 2 ? static_cast<std::size_t>(dims[1]) : 1;
+  }
   const H5T_class_t type_class = H5Tget_class(type.get());
   if (type_class == H5T_FLOAT) c.kind = Kind::kFloat;
   else if (type_class == H5T_INTEGER)
     c.kind = H5Tget_sign(type.get()) == H5T_SGN_NONE ? Kind::kUnsigned : Kind::kSigned;
   else fail(context + ": elements are neither floating-point numbers nor integers");
-  h5::Handle space = h5::checked(H5Dget_space(c.dataset.get()), H5Sclose, context);
-  c.rank = H5Sget_simple_extent_ndims(space.get());
-  if (c.rank != 1 && c.rank != 2)
-    fail(context + ": has " + std::to_string(c.rank) + " dimensions (a trace column has 1 or 2)");
-  hsize_t dims[2] = {0, 1};
-  h5::check(H5Sget_simple_extent_dims(space.get(), dims, nullptr), context);
-  c.rows = static_cast<std::int64_t>(dims[0]);
-  c.width = c.rank == 2 ? static_cast<std::size_t>(dims[1]) : 1;
-  if (h5::has_attribute(c.dataset.get(), "units", context))
-    c.units = attribute_text(c.dataset.get(), "units", context);
-  if (h5::has_attribute(c.dataset.get(), "order", context))
-    c.order = split_order(attribute_text(c.dataset.get(), "order", context));
+  if (h5::has_attribute(c.dataset.get(), units_key, context))
+    c.units = attribute_text(c.dataset.get(), units_key, context);
+  if (h5::has_attribute(c.dataset.get(), order_key, context))
+    c.order = split_order(attribute_text(c.dataset.get(), order_key, context));
   return c;
 }
 
@@ -241,12 +309,29 @@ class BlockReader {
     h5::Handle file_space = h5::checked(H5Dget_space(c_.dataset.get()), H5Sclose, context);
     const hsize_t offset[2] = {static_cast<hsize_t>(start_), 0};
     const hsize_t count[2] = {static_cast<hsize_t>(count_), c_.width};
+    // A member of a compound table: a one-member memory type picks it out of the rows.
+    h5::Handle member_type;
+    hid_t read_type = memory_type<T>();
+    int rank = c_.rank;
+    if (!c_.member.empty()) {
+      rank = 1;
+      h5::Handle field;
+      if (c_.width > 1) {
+        const hsize_t dims[1] = {c_.width};
+        field = h5::checked(H5Tarray_create2(memory_type<T>(), 1, dims), H5Tclose, context);
+      } else {
+        field = h5::checked(H5Tcopy(memory_type<T>()), H5Tclose, context);
+      }
+      member_type = h5::checked(H5Tcreate(H5T_COMPOUND, sizeof(T) * c_.width), H5Tclose, context);
+      h5::check(H5Tinsert(member_type.get(), c_.member.c_str(), 0, field.get()), context);
+      read_type = member_type.get();
+    }
     h5::check(H5Sselect_hyperslab(file_space.get(), H5S_SELECT_SET, offset, nullptr, count,
                                   nullptr),
               context);
-    h5::Handle mem_space = h5::checked(H5Screate_simple(c_.rank, count, nullptr), H5Sclose,
+    h5::Handle mem_space = h5::checked(H5Screate_simple(rank, count, nullptr), H5Sclose,
                                        context);
-    h5::check(H5Dread(c_.dataset.get(), memory_type<T>(), mem_space.get(), file_space.get(),
+    h5::check(H5Dread(c_.dataset.get(), read_type, mem_space.get(), file_space.get(),
                       H5P_DEFAULT, buffer_.data()),
               context + ": cannot read rows " + std::to_string(start_) + " to " +
                   std::to_string(start_ + count_ - 1));
@@ -415,8 +500,8 @@ void compare_loop(const OpenTrace& a, const OpenTrace& b, const std::string& gro
 
   std::vector<Column> cols_a, cols_b;
   for (const std::string& n : names_a) {
-    cols_a.push_back(open_column(a, "/" + group + "/" + n));
-    cols_b.push_back(open_column(b, "/" + group + "/" + n));
+    cols_a.push_back(open_column(a, group, n));
+    cols_b.push_back(open_column(b, group, n));
   }
   // A table's datasets grow together; if they do not (a write cut by a crash), only the rows
   // every dataset holds are compared.
@@ -665,6 +750,7 @@ bool CompareResult::same() const {
 
 CompareResult compare_traces(const std::string& a, const std::string& b,
                              const CompareOptions& options) {
+  h5::Lock lock;
   h5::Quiet quiet;
   try {
     return compare_impl(a, b, options);

@@ -28,6 +28,7 @@ RepairResult repair_trace(const std::string& path) {
   result.status_before = read_string_attribute(path, "/", "status");
   result.status_after = result.status_before;
   if (result.status_before == "running") {
+    h5::Lock lock;
     h5::Quiet quiet;
     const std::string where = context + ": cannot repair";
     h5::Handle fapl = h5::checked(H5Pcreate(H5P_FILE_ACCESS), H5Pclose, where);
@@ -44,6 +45,7 @@ RepairResult repair_trace(const std::string& path) {
   }
   // It must now open as a plain reader (no SWMR), as h5dump does.
   {
+    h5::Lock lock;
     h5::Quiet quiet;
     const hid_t id = H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
     if (id < 0) throw TraceError(context + ": still does not open without SWMR: " + h5::last_error());

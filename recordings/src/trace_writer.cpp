@@ -1,13 +1,19 @@
-// TraceWriter and TraceTable: rows buffered per table, appended block by block to chunked
-// HDF5 datasets (H5Dset_extent + hyperslab + H5Dwrite per column).
+// TraceWriter and TraceTable: each table is one chunked HDF5 dataset of compound rows (one
+// member per column), appended block by block (H5Dset_extent + hyperslab + one H5Dwrite per
+// block), optionally by a background thread (recordings/README.md "Cost" and "Schema").
 #include "graspsim/recordings/trace_writer.hpp"
 
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <condition_variable>
+#include <cstring>
+#include <exception>
 #include <functional>
 #include <map>
+#include <mutex>
 #include <sstream>
+#include <thread>
 #include <type_traits>
 #include <vector>
 
@@ -16,7 +22,7 @@
 namespace graspsim::recordings {
 namespace {
 
-// Checks a relative HDF5 path: non-empty components, none of them ".", no leading '/'.
+// Checks a relative path: non-empty components, none of them "." or "..", no leading '/'.
 bool is_relative_path(const std::string& path) {
   if (path.empty() || path.front() == '/' || path.back() == '/') return false;
   std::size_t start = 0;
@@ -38,6 +44,26 @@ hid_t file_type_of(DType dtype) {
     case DType::kUInt64: return H5T_STD_U64LE;
   }
   return H5T_IEEE_F64LE;
+}
+
+hid_t memory_type_of(DType dtype) {
+  switch (dtype) {
+    case DType::kFloat64: return H5T_NATIVE_DOUBLE;
+    case DType::kInt64: return H5T_NATIVE_INT64;
+    case DType::kInt32: return H5T_NATIVE_INT32;
+    case DType::kInt8: return H5T_NATIVE_INT8;
+    case DType::kUInt64: return H5T_NATIVE_UINT64;
+  }
+  return H5T_NATIVE_DOUBLE;
+}
+
+std::size_t size_of(DType dtype) {
+  switch (dtype) {
+    case DType::kFloat64: case DType::kInt64: case DType::kUInt64: return 8;
+    case DType::kInt32: return 4;
+    case DType::kInt8: return 1;
+  }
+  return 8;
 }
 
 const char* name_of(DType dtype) {
@@ -82,28 +108,11 @@ bool fits(double value, DType dtype) {
 std::string quoted(const std::string& text) { return "'" + text + "'"; }
 
 struct Column {
-  std::string path;      // absolute, e.g. "/servo/fingers/thumb/hip"
+  std::string name;      // member name, relative to the table: "fingers/thumb/hip"
   int width;             // values per row
   DType dtype;
-  std::size_t offset;    // into a row
-  h5::Handle dataset;
-};
-
-// What the writer and its tables share about the file: whether its layout is frozen (the first
-// row was appended) and SWMR writing started.
-struct FileState {
-  hid_t file = H5I_INVALID_HID;   // not owned (TraceWriter::Impl::file)
-  std::string context;            // "trace 'PATH'"
-  bool swmr = true;               // TraceOptions::swmr
-  bool frozen = false;            // a row was appended: no new table, column or table attribute
-
-  void freeze() {
-    if (frozen) return;
-    if (swmr && H5Fstart_swmr_write(file) < 0) {
-      throw TraceError(context + ": cannot start SWMR writing: " + h5::last_error());
-    }
-    frozen = true;
-  }
+  std::size_t offset;    // doubles into a row of the block buffer
+  std::size_t bytes;     // bytes into a packed compound row
 };
 
 // Object creation properties without modification times, so that two runs write the same
@@ -120,43 +129,181 @@ h5::Handle file_access(bool swmr, const std::string& where) {
   return fapl;
 }
 
+// A block of rows on its way to the file: `count` rows of a table, row-major doubles.
+struct Block {
+  TraceTable::Impl* table = nullptr;
+  std::vector<double> rows;   // block_rows x row_width
+  std::size_t count = 0;      // rows filled
+};
+
+// One piece of work for the file, done in submission order: append a block, flush, or (the
+// first job) create every table's dataset and start SWMR writing.
+struct Job {
+  Block* block = nullptr;   // nullptr: H5Fflush, or the layout when `create` is set
+  bool create = false;
+};
+
 }  // namespace
+
+// Everything that touches the file after its layout is frozen goes through here, in the order
+// it was submitted: inline (TraceOptions::background false) or on one writer thread. The
+// simulation thread only fills blocks and hands them over (recordings/README.md "Cost").
+class TraceWriterWorker {
+ public:
+  using Run = std::function<void(const Job&)>;   // does a job (on the writer thread)
+
+  // `capacity`: the most jobs ever waiting (each block is in at most one, and flushes between
+  // two blocks are merged), so the ring never grows after start().
+  void start(bool thread, std::size_t capacity, Run run) {
+    run_ = std::move(run);
+    ring_.assign(capacity + 1, Job{});
+    threaded_ = thread;
+    if (threaded_) worker_ = std::thread([this] { loop(); });
+  }
+
+  // Hands a job over (runs it at once without a thread). Rethrows a failure of an earlier job.
+  void submit(const Job& job) {
+    if (!threaded_) {
+      rethrow();
+      try {
+        run_(job);
+      } catch (...) {
+        error_ = std::current_exception();
+        throw;
+      }
+      return;
+    }
+    std::unique_lock lock(mutex_);
+    if (error_) std::rethrow_exception(error_);
+    // A flush right after a flush still waiting adds nothing.
+    const Job& last = ring_[(head_ + size_ + ring_.size() - 1) % ring_.size()];
+    if (job.block == nullptr && !job.create && size_ > 0 && last.block == nullptr && !last.create) {
+      return;
+    }
+    ring_[(head_ + size_) % ring_.size()] = job;
+    ++size_;
+    wake_.notify_one();
+  }
+
+  // Waits until every job submitted so far is done. Rethrows the first failure.
+  void drain() {
+    if (threaded_) {
+      std::unique_lock lock(mutex_);
+      idle_.wait(lock, [this] { return size_ == 0 && !busy_; });
+    }
+    rethrow();
+  }
+
+  // Drains, then ends the thread. Never throws; the failure stays for failure().
+  void stop() noexcept {
+    if (threaded_) {
+      {
+        std::unique_lock lock(mutex_);
+        idle_.wait(lock, [this] { return size_ == 0 && !busy_; });
+        stopping_ = true;
+      }
+      wake_.notify_one();
+      if (worker_.joinable()) worker_.join();
+      threaded_ = false;
+    }
+  }
+
+  std::exception_ptr failure() {
+    std::lock_guard lock(mutex_);
+    return error_;
+  }
+  void rethrow() {
+    std::exception_ptr e = failure();
+    if (e) std::rethrow_exception(e);
+  }
+
+  // The mutex and condition the block pools share with the writer thread.
+  std::mutex& mutex() { return mutex_; }
+  std::condition_variable& returned() { return returned_; }
+
+ private:
+  void loop() {
+    std::unique_lock lock(mutex_);
+    for (;;) {
+      wake_.wait(lock, [this] { return size_ > 0 || stopping_; });
+      if (size_ == 0 && stopping_) return;
+      const Job job = ring_[head_];
+      busy_ = true;
+      lock.unlock();
+      std::exception_ptr failed;
+      try {
+        run_(job);
+      } catch (...) {
+        failed = std::current_exception();
+      }
+      lock.lock();
+      if (failed && !error_) error_ = failed;
+      head_ = (head_ + 1) % ring_.size();
+      --size_;
+      busy_ = false;
+      if (size_ == 0) idle_.notify_all();
+    }
+  }
+
+  Run run_;
+  std::vector<Job> ring_;
+  std::size_t head_ = 0, size_ = 0;
+  bool threaded_ = false, busy_ = false, stopping_ = false;
+  std::exception_ptr error_;
+  std::mutex mutex_;
+  std::condition_variable wake_, idle_, returned_;
+  std::thread worker_;
+};
+
+// What the writer and its tables share about the file.
+struct TraceFileState {
+  hid_t file = H5I_INVALID_HID;   // not owned (TraceWriter::Impl::file)
+  std::string context;            // "trace 'PATH'"
+  TraceOptions options;
+  bool frozen = false;            // a row was appended: no new table, column or attribute
+  std::function<void()> freeze;   // TraceWriter::Impl::freeze
+  TraceWriterWorker worker;
+};
 
 // ---------------------------------------------------------------------------------------------
 // TraceTable
 
 struct TraceTable::Impl {
   std::string file_path;
-  std::string group_path;   // "/servo"
-  TraceOptions options;
-  std::size_t block_rows = 0;    // rows buffered before a write, and rows per chunk
-  FileState* file = nullptr;     // owned by the writer
-  h5::Handle group;
+  std::string name;              // dataset path without the leading '/': "servo"
+  std::size_t block_rows = 0;    // rows per block, and rows per chunk
+  TraceFileState* file = nullptr;   // owned by the writer
   std::vector<Column> columns;
+  std::vector<std::pair<std::string, std::string>> attributes;   // name, value; in call order
   std::size_t row_width = 0;     // doubles per row
-  std::size_t max_width = 0;     // widest column
-  std::vector<double> buffer;    // block_rows x row_width, row-major
-  // One column's block in its memory type, filled by flush() (sized on the first row).
-  std::vector<double> scratch_f64;
-  std::vector<std::int64_t> scratch_i64;
-  std::vector<std::int32_t> scratch_i32;
-  std::vector<std::int8_t> scratch_i8;
-  std::vector<std::uint64_t> scratch_u64;
-  std::size_t buffered = 0;      // rows in `buffer`
-  std::int64_t rows = 0;         // rows appended
-  std::int64_t written = 0;      // rows on disk
-  bool started = false;          // append_row was called
+  std::size_t packed_width = 0;  // bytes per compound row
   bool closed = false;           // the writer closed the file
 
+  // Simulation side (after the first row): the block being filled and the free ones.
+  std::vector<std::unique_ptr<Block>> blocks;   // all of them (owned)
+  std::vector<Block*> free_blocks;              // guarded by the worker's mutex
+  Block* current = nullptr;
+  std::int64_t rows = 0;         // rows appended
+  bool started = false;          // append_row was called
+
+  // Writer side.
+  h5::Handle dataset;
+  h5::Handle memory_type;        // the compound row in memory (native types, packed)
+  std::vector<unsigned char> packed;   // block_rows x packed_width
+  std::int64_t written = 0;      // rows on disk
+
   std::string context() const { return "trace " + quoted(file_path); }
-  std::string context(const std::string& dataset) const {
-    return context() + ", dataset " + quoted(dataset);
+  std::string column_context(const std::string& column) const {
+    return context() + ", column " + quoted("/" + name + "/" + column);
   }
   void require_open() const {
-    if (closed) throw TraceError(context() + ": table " + quoted(group_path) + " used after close");
+    if (closed) throw TraceError(context() + ": table " + quoted("/" + name) + " used after close");
   }
-  void write_column(Column& column);
-  void write_block();
+  void allocate();                      // at freeze: the blocks (simulation side)
+  void create_dataset(hid_t file_id);   // the first job, before SWMR starts (writer side)
+  void write_block(Block& block);       // writer side
+  void hand_over();                     // simulation side: current block to the worker
+  Block* take_free_block();
 };
 
 TraceTable::TraceTable(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
@@ -166,75 +313,56 @@ std::size_t TraceTable::add_column(const std::string& path, int width, DType dty
                                    const std::string& units) {
   Impl& t = *impl_;
   t.require_open();
-  const std::string full = t.group_path + "/" + path;
   if (t.started || t.file->frozen) {
-    throw TraceError(t.context(full) + ": add_column after the first row of " +
-                     quoted(t.group_path) + " or of the file");
+    throw TraceError(t.column_context(path) + ": add_column after the first row of " +
+                     quoted("/" + t.name) + " or of the file");
   }
   if (!is_relative_path(path)) {
-    throw TraceError(t.context(full) + ": column path must be relative, like 'fingers/a/hip'");
+    throw TraceError(t.column_context(path) + ": column path must be relative, like 'fingers/a/hip'");
   }
-  if (width < 1) throw TraceError(t.context(full) + ": width must be at least 1");
+  if (width < 1) throw TraceError(t.column_context(path) + ": width must be at least 1");
   for (const Column& c : t.columns) {
-    if (c.path == full) throw TraceError(t.context(full) + ": column declared twice");
+    if (c.name == path) throw TraceError(t.column_context(path) + ": column declared twice");
   }
-
-  h5::Quiet quiet;
-  const std::string where = t.context(full) + ": cannot create dataset";
-  // Shape (0,) or (0, width), unlimited rows, one chunk per block.
-  const int rank = width == 1 ? 1 : 2;
-  const hsize_t dims[2] = {0, static_cast<hsize_t>(width)};
-  const hsize_t max_dims[2] = {H5S_UNLIMITED, static_cast<hsize_t>(width)};
-  const hsize_t chunk[2] = {static_cast<hsize_t>(t.block_rows),
-                            static_cast<hsize_t>(width)};
-  h5::Handle space = h5::checked(H5Screate_simple(rank, dims, max_dims), H5Sclose, where);
-  h5::Handle dcpl = untimed(H5P_DATASET_CREATE, where);
-  h5::check(H5Pset_chunk(dcpl.get(), rank, chunk), where);
-  if (t.options.compression > 0) {
-    h5::check(H5Pset_deflate(dcpl.get(), static_cast<unsigned>(t.options.compression)), where);
-  }
-  h5::Handle lcpl = h5::checked(H5Pcreate(H5P_LINK_CREATE), H5Pclose, where);
-  h5::check(H5Pset_create_intermediate_group(lcpl.get(), 1), where);
-  h5::Handle dataset = h5::checked(H5Dcreate2(t.group.get(), path.c_str(), file_type_of(dtype),
-                                              space.get(), lcpl.get(), dcpl.get(), H5P_DEFAULT),
-                                   H5Dclose, where);
-  h5::write_string_attribute(dataset.get(), "units", units, t.context(full));
-
   const std::size_t offset = t.row_width;
-  t.columns.push_back(Column{full, width, dtype, offset, std::move(dataset)});
+  t.columns.push_back(Column{path, width, dtype, offset, t.packed_width});
   t.row_width += static_cast<std::size_t>(width);
-  t.max_width = std::max(t.max_width, static_cast<std::size_t>(width));
+  t.packed_width += static_cast<std::size_t>(width) * size_of(dtype);
+  t.attributes.emplace_back(path + "/units", units);
   return offset;
+}
+
+Block* TraceTable::Impl::take_free_block() {
+  std::unique_lock lock(file->worker.mutex());
+  // A full pool means the writer is behind: wait for it (back-pressure) rather than grow.
+  file->worker.returned().wait(lock, [this] { return !free_blocks.empty(); });
+  Block* block = free_blocks.back();
+  free_blocks.pop_back();
+  block->count = 0;
+  return block;
+}
+
+void TraceTable::Impl::hand_over() {
+  if (current == nullptr || current->count == 0) return;
+  // If the writer has failed, submit rethrows and the block stays current (its rows unwritten).
+  file->worker.submit(Job{current});
+  current = take_free_block();
 }
 
 double* TraceTable::append_row() {
   Impl& t = *impl_;
   t.require_open();
   if (!t.started) {
-    // Everything the table will ever need, allocated once.
-    const std::size_t block = t.block_rows;
-    t.buffer.assign(block * t.row_width, 0.0);
-    std::size_t need[5] = {0, 0, 0, 0, 0};
-    for (const Column& c : t.columns) need[static_cast<int>(c.dtype)] = block * t.max_width;
-    t.scratch_f64.assign(need[static_cast<int>(DType::kFloat64)], 0.0);
-    t.scratch_i64.assign(need[static_cast<int>(DType::kInt64)], 0);
-    t.scratch_i32.assign(need[static_cast<int>(DType::kInt32)], 0);
-    t.scratch_i8.assign(need[static_cast<int>(DType::kInt8)], 0);
-    t.scratch_u64.assign(need[static_cast<int>(DType::kUInt64)], 0);
-    h5::Quiet quiet;
-    t.file->freeze();
+    if (!t.file->frozen) t.file->freeze();
     t.started = true;
   }
-  if (t.buffered == t.block_rows) {
-    h5::Quiet quiet;
-    t.write_block();
+  if (t.current->count == t.block_rows) {
+    t.hand_over();
     // Metadata too, so that a run cut short leaves a readable file up to this block.
-    if (H5Fflush(t.group.get(), H5F_SCOPE_LOCAL) < 0) {
-      throw TraceError(t.context() + ": cannot flush: " + h5::last_error());
-    }
+    t.file->worker.submit(Job{nullptr});
   }
-  double* row = t.buffer.data() + t.buffered * t.row_width;
-  ++t.buffered;
+  double* row = t.current->rows.data() + t.current->count * t.row_width;
+  ++t.current->count;
   ++t.rows;
   return row;
 }
@@ -245,104 +373,171 @@ std::int64_t TraceTable::rows() const { return impl_->rows; }
 
 void TraceTable::flush() {
   impl_->require_open();
-  h5::Quiet quiet;
-  impl_->write_block();
+  if (!impl_->started) return;
+  impl_->hand_over();
+  impl_->file->worker.drain();
 }
 
 void TraceTable::set_attribute(const std::string& dataset_or_dot, const std::string& name,
                                const std::string& value) {
   Impl& t = *impl_;
   t.require_open();
-  const std::string full =
-      dataset_or_dot == "." ? t.group_path : t.group_path + "/" + dataset_or_dot;
+  const std::string full = dataset_or_dot == "." ? "/" + t.name : "/" + t.name + "/" + dataset_or_dot;
   if (t.file->frozen) {
-    throw TraceError(t.context(full) + ": attribute '" + name + "' after the file's first row");
+    throw TraceError(t.context() + ", object " + quoted(full) + ": attribute '" + name +
+                     "' after the file's first row");
   }
-  if (dataset_or_dot != "." && !is_relative_path(dataset_or_dot)) {
-    throw TraceError(t.context(full) + ": not a path relative to " + quoted(t.group_path));
+  if (name.empty() || name.find('/') != std::string::npos) {
+    throw TraceError(t.context() + ", object " + quoted(full) + ": bad attribute name " + quoted(name));
   }
-  h5::Quiet quiet;
-  h5::Handle object = h5::checked(H5Oopen(t.group.get(), dataset_or_dot.c_str(), H5P_DEFAULT),
-                                  H5Oclose, t.context() + ": no object " + quoted(full));
-  h5::write_string_attribute(object.get(), name, value, t.context() + ", object " + quoted(full));
+  std::string key = name;
+  if (dataset_or_dot != ".") {
+    // A column, or a prefix of columns ("fingers/thumb"), as a group was in schema 2.
+    const bool known = std::any_of(t.columns.begin(), t.columns.end(), [&](const Column& c) {
+      return c.name == dataset_or_dot || c.name.rfind(dataset_or_dot + "/", 0) == 0;
+    });
+    if (!known) throw TraceError(t.context() + ": no column " + quoted(full));
+    key = dataset_or_dot + "/" + name;
+  }
+  std::erase_if(t.attributes, [&key](const auto& a) { return a.first == key; });
+  t.attributes.emplace_back(key, value);
 }
 
-// Appends the buffered rows to every dataset. On failure nothing is forgotten: the rows stay
-// buffered and a retry rewrites the same rows of every column.
-void TraceTable::Impl::write_block() {
-  if (buffered == 0) return;
-  for (Column& column : columns) write_column(column);
-  written += static_cast<std::int64_t>(buffered);
-  buffered = 0;
-}
-
-// Allocates nothing on success (messages are built only on failure); HDF5 mallocs its own.
-void TraceTable::Impl::write_column(Column& column) {
-  const std::size_t n = buffered;
-  const std::size_t width = static_cast<std::size_t>(column.width);
-  auto fail = [&]() {
-    throw TraceError(context(column.path) + ": cannot append rows: " + h5::last_error());
-  };
-
-  // Gather the column out of the row-major buffer into its memory type: a plain copy for
-  // float64, the raw bits for uint64, a checked conversion for the signed integers.
-  const void* data = nullptr;
-  hid_t memory_type = H5T_NATIVE_DOUBLE;
-  auto gather = [&](auto& out) {
-    using T = std::remove_reference_t<decltype(out[0])>;
-    const double* src = buffer.data() + column.offset;
-    T* dst = out.data();
-    if constexpr (std::is_same_v<T, double>) {
-      for (std::size_t r = 0; r < n; ++r, src += row_width, dst += width) {
-        for (std::size_t c = 0; c < width; ++c) dst[c] = src[c];
-      }
-    } else if constexpr (std::is_same_v<T, std::uint64_t>) {   // raw bits, see uint64_in_row
-      for (std::size_t r = 0; r < n; ++r, src += row_width, dst += width) {
-        for (std::size_t c = 0; c < width; ++c) dst[c] = std::bit_cast<std::uint64_t>(src[c]);
-      }
+// The compound type of a row: one member per column in declaration order, packed; array
+// members for width > 1.
+static h5::Handle row_type(const std::vector<Column>& columns, std::size_t bytes, bool memory,
+                           const std::string& where) {
+  h5::Handle type = h5::checked(H5Tcreate(H5T_COMPOUND, bytes), H5Tclose, where);
+  for (const Column& c : columns) {
+    const hid_t base = memory ? memory_type_of(c.dtype) : file_type_of(c.dtype);
+    if (c.width == 1) {
+      h5::check(H5Tinsert(type.get(), c.name.c_str(), c.bytes, base), where);
     } else {
-      for (std::size_t r = 0; r < n; ++r, src += row_width, dst += width) {
-        for (std::size_t c = 0; c < width; ++c) {
-          const double value = src[c];
-          if (!fits(value, column.dtype)) {
-            std::ostringstream message;
-            message.precision(17);
-            message << context(column.path) << ": row " << (written + static_cast<std::int64_t>(r))
-                    << " holds " << value << ", which is not an " << name_of(column.dtype);
-            throw TraceError(message.str());
+      const hsize_t dims[1] = {static_cast<hsize_t>(c.width)};
+      h5::Handle array = h5::checked(H5Tarray_create2(base, 1, dims), H5Tclose, where);
+      h5::check(H5Tinsert(type.get(), c.name.c_str(), c.bytes, array.get()), where);
+    }
+  }
+  return type;
+}
+
+void TraceTable::Impl::create_dataset(hid_t file_id) {
+  const std::string where = context() + ": cannot create table " + quoted("/" + name);
+  if (columns.empty()) throw TraceError(where + ": it has no columns");
+  h5::Handle file_type = row_type(columns, packed_width, false, where);
+  memory_type = row_type(columns, packed_width, true, where);
+  // Shape (0,), unlimited rows, one chunk per block.
+  const hsize_t dims[1] = {0};
+  const hsize_t max_dims[1] = {H5S_UNLIMITED};
+  const hsize_t chunk[1] = {static_cast<hsize_t>(block_rows)};
+  h5::Handle space = h5::checked(H5Screate_simple(1, dims, max_dims), H5Sclose, where);
+  h5::Handle dcpl = untimed(H5P_DATASET_CREATE, where);
+  // The column attributes (a hundred or so) stay in the object header: compact storage is several
+  // times cheaper to create than the dense storage (fractal heap + B-tree) that the newest file
+  // format switches to after 8.
+  const unsigned compact = static_cast<unsigned>(std::min<std::size_t>(attributes.size() + 8, 1000));
+  h5::check(H5Pset_attr_phase_change(dcpl.get(), compact, compact > 8 ? compact - 8 : 0), where);
+  h5::check(H5Pset_chunk(dcpl.get(), 1, chunk), where);
+  // Every row is written before it is read: no fill values (they cost a memset of each new chunk).
+  h5::check(H5Pset_fill_time(dcpl.get(), H5D_FILL_TIME_NEVER), where);
+  if (file->options.compression > 0) {
+    // Byte shuffle first: with a compound element it groups the k-th byte of every row, so
+    // each column's slowly changing high bytes sit together for deflate.
+    h5::check(H5Pset_shuffle(dcpl.get()), where);
+    h5::check(H5Pset_deflate(dcpl.get(), static_cast<unsigned>(file->options.compression)), where);
+  }
+  h5::Handle lcpl = h5::checked(H5Pcreate(H5P_LINK_CREATE), H5Pclose, where);
+  h5::check(H5Pset_create_intermediate_group(lcpl.get(), 1), where);
+  dataset = h5::checked(H5Dcreate2(file_id, ("/" + name).c_str(), file_type.get(), space.get(),
+                                   lcpl.get(), dcpl.get(), H5P_DEFAULT),
+                        H5Dclose, where);
+  // Sorted by name, so the file does not depend on the order attributes were set in.
+  std::vector<std::pair<std::string, std::string>> sorted = attributes;
+  std::sort(sorted.begin(), sorted.end());
+  for (const auto& [key, value] : sorted) {
+    h5::create_string_attribute(dataset.get(), key, value, context() + ", table " + quoted("/" + name));
+  }
+  packed.assign(block_rows * packed_width, 0);
+}
+
+// Everything the table will ever need, allocated once: a few blocks so the simulation can fill
+// one while the writer thread writes others.
+void TraceTable::Impl::allocate() {
+  const std::size_t pool = file->options.background ? 4 : 1;
+  for (std::size_t k = 0; k < pool; ++k) {
+    auto block = std::make_unique<Block>();
+    block->table = this;
+    block->rows.assign(block_rows * row_width, 0.0);
+    free_blocks.push_back(block.get());
+    blocks.push_back(std::move(block));
+  }
+  current = free_blocks.back();
+  free_blocks.pop_back();
+}
+
+// Packs the block's rows into compound rows (checking integer columns) and appends them.
+// Allocates nothing on success (messages are built only on failure); HDF5 mallocs its own.
+void TraceTable::Impl::write_block(Block& block) {
+  const std::size_t n = block.count;
+  for (std::size_t r = 0; r < n; ++r) {
+    const double* src = block.rows.data() + r * row_width;
+    unsigned char* dst = packed.data() + r * packed_width;
+    for (const Column& c : columns) {
+      const double* in = src + c.offset;
+      unsigned char* out = dst + c.bytes;
+      const std::size_t w = static_cast<std::size_t>(c.width);
+      switch (c.dtype) {
+        case DType::kFloat64:
+          std::memcpy(out, in, w * sizeof(double));
+          break;
+        case DType::kUInt64:   // the raw bits, see uint64_in_row
+          std::memcpy(out, in, w * sizeof(double));
+          break;
+        default:
+          for (std::size_t k = 0; k < w; ++k) {
+            const double value = in[k];
+            if (!fits(value, c.dtype)) {
+              std::ostringstream message;
+              message.precision(17);
+              message << column_context(c.name) << ": row " << (written + static_cast<std::int64_t>(r))
+                      << " holds " << value << ", which is not an " << name_of(c.dtype);
+              throw TraceError(message.str());
+            }
+            if (c.dtype == DType::kInt64) {
+              const std::int64_t v = static_cast<std::int64_t>(value);
+              std::memcpy(out + 8 * k, &v, 8);
+            } else if (c.dtype == DType::kInt32) {
+              const std::int32_t v = static_cast<std::int32_t>(value);
+              std::memcpy(out + 4 * k, &v, 4);
+            } else {
+              const std::int8_t v = static_cast<std::int8_t>(value);
+              std::memcpy(out + k, &v, 1);
+            }
           }
-          dst[c] = static_cast<T>(value);
-        }
+          break;
       }
     }
-    data = out.data();
-  };
-  switch (column.dtype) {
-    case DType::kFloat64: gather(scratch_f64); memory_type = H5T_NATIVE_DOUBLE; break;
-    case DType::kInt64: gather(scratch_i64); memory_type = H5T_NATIVE_INT64; break;
-    case DType::kInt32: gather(scratch_i32); memory_type = H5T_NATIVE_INT32; break;
-    case DType::kInt8: gather(scratch_i8); memory_type = H5T_NATIVE_INT8; break;
-    case DType::kUInt64: gather(scratch_u64); memory_type = H5T_NATIVE_UINT64; break;
   }
-
-  // Grow the dataset and write the block into its new rows.
-  const int rank = column.width == 1 ? 1 : 2;
-  const hsize_t new_dims[2] = {static_cast<hsize_t>(written) + n, width};
-  const hsize_t start[2] = {static_cast<hsize_t>(written), 0};
-  const hsize_t count[2] = {n, width};
-  if (H5Dset_extent(column.dataset.get(), new_dims) < 0) fail();
-
-  h5::Handle file_space(H5Dget_space(column.dataset.get()), H5Sclose);
+  auto fail = [&]() {
+    throw TraceError(context() + ", table " + quoted("/" + name) + ": cannot append rows: " +
+                     h5::last_error());
+  };
+  const hsize_t new_dims[1] = {static_cast<hsize_t>(written) + n};
+  const hsize_t start[1] = {static_cast<hsize_t>(written)};
+  const hsize_t count[1] = {n};
+  if (H5Dset_extent(dataset.get(), new_dims) < 0) fail();
+  h5::Handle file_space(H5Dget_space(dataset.get()), H5Sclose);
   if (!file_space.valid()) fail();
   if (H5Sselect_hyperslab(file_space.get(), H5S_SELECT_SET, start, nullptr, count, nullptr) < 0) {
     fail();
   }
-  h5::Handle memory_space(H5Screate_simple(rank, count, nullptr), H5Sclose);
+  h5::Handle memory_space(H5Screate_simple(1, count, nullptr), H5Sclose);
   if (!memory_space.valid()) fail();
-  if (H5Dwrite(column.dataset.get(), memory_type, memory_space.get(), file_space.get(),
-               H5P_DEFAULT, data) < 0) {
+  if (H5Dwrite(dataset.get(), memory_type.get(), memory_space.get(), file_space.get(),
+               H5P_DEFAULT, packed.data()) < 0) {
     fail();
   }
+  written += static_cast<std::int64_t>(n);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -353,10 +548,10 @@ struct TraceWriter::Impl {
   TraceOptions options;
   h5::Handle file;
   h5::Handle root;
-  FileState state;
+  TraceFileState state;
   // Root attributes set after the first row, written by close() (name, writer), in call order.
   std::vector<std::pair<std::string, std::function<void(hid_t)>>> pending;
-  // Ordered by name, so flush order (and the file's layout) does not depend on first use.
+  // Ordered by name, so the file's layout does not depend on first use.
   std::map<std::string, std::unique_ptr<TraceTable>> tables;
   bool closed = false;
 
@@ -365,7 +560,63 @@ struct TraceWriter::Impl {
     if (closed) throw TraceError(context() + ": used after close");
   }
   void set_root_attribute(const std::string& name, std::function<void(hid_t)> write);
+  void freeze();
+  void run(const Job& job);   // on the writer thread (or inline)
 };
+
+// The first row of any table freezes the layout: blocks are allocated here; the first job then
+// creates every table's dataset and starts SWMR writing (on the writer thread, if there is one:
+// it costs a few milliseconds), and from here on only the worker touches the file.
+void TraceWriter::Impl::freeze() {
+  std::size_t blocks = 0;
+  for (auto& [name, table] : tables) {
+    if (table->impl_->columns.empty()) {
+      throw TraceError(context() + ": cannot create table " + quoted("/" + name) + ": it has no columns");
+    }
+  }
+  for (auto& [name, table] : tables) {
+    table->impl_->allocate();
+    blocks += table->impl_->blocks.size();
+  }
+  state.frozen = true;
+  state.worker.start(options.background, 2 * blocks + 3, [this](const Job& job) { run(job); });
+  state.worker.submit(Job{nullptr, true});
+}
+
+void TraceWriter::Impl::run(const Job& job) {
+  h5::Lock lock;
+  h5::Quiet quiet;
+  if (job.create) {
+    for (auto& [name, table] : tables) table->impl_->create_dataset(file.get());
+    if (options.swmr && H5Fstart_swmr_write(file.get()) < 0) {
+      throw TraceError(context() + ": cannot start SWMR writing: " + h5::last_error());
+    }
+    return;
+  }
+  if (job.block == nullptr) {
+    if (H5Fflush(file.get(), H5F_SCOPE_LOCAL) < 0) {
+      throw TraceError(context() + ": cannot flush: " + h5::last_error());
+    }
+    return;
+  }
+  Block& block = *job.block;
+  TraceTable::Impl& table = *block.table;
+  // The block goes back to its pool whatever happens, so the simulation never waits forever.
+  struct GiveBack {
+    TraceFileState& state;
+    TraceTable::Impl& table;
+    Block& block;
+    ~GiveBack() {
+      {
+        std::lock_guard guard(state.worker.mutex());
+        table.free_blocks.push_back(&block);
+      }
+      state.worker.returned().notify_all();
+    }
+  } give_back{state, table, block};
+  if (state.worker.failure()) return;   // after a failure, later rows are not written
+  table.write_block(block);
+}
 
 TraceWriter::TraceWriter(const std::string& path, TraceOptions options)
     : impl_(std::make_unique<Impl>()) {
@@ -376,13 +627,15 @@ TraceWriter::TraceWriter(const std::string& path, TraceOptions options)
   if (options.compression < 0 || options.compression > 9) {
     throw TraceError(where + ": compression must be 0 (none) or a deflate level 1..9");
   }
+  h5::Lock lock;
   h5::Quiet quiet;
   h5::Handle fapl = file_access(options.swmr, where);
   impl_->file = h5::checked(H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, fapl.get()),
                             H5Fclose, where);
   impl_->state.file = impl_->file.get();
   impl_->state.context = impl_->context();
-  impl_->state.swmr = options.swmr;
+  impl_->state.options = options;
+  impl_->state.freeze = [impl = impl_.get()] { impl->freeze(); };
   impl_->root = h5::checked(H5Gopen2(impl_->file.get(), "/", H5P_DEFAULT), H5Gclose, where);
   h5::write_string_attribute(impl_->root.get(), "status", "running", where);
   h5::check(H5Fflush(impl_->file.get(), H5F_SCOPE_LOCAL), where);
@@ -407,20 +660,17 @@ TraceTable& TraceWriter::table(const std::string& group, std::size_t block_rows)
   if (w.state.frozen) {
     throw TraceError(w.context() + ": table " + quoted(group) + " created after the file's first row");
   }
-  h5::Quiet quiet;
-  const std::string where = w.context() + ": cannot create group " + quoted("/" + name);
-  h5::Handle lcpl = h5::checked(H5Pcreate(H5P_LINK_CREATE), H5Pclose, where);
-  h5::check(H5Pset_create_intermediate_group(lcpl.get(), 1), where);
-  h5::Handle gcpl = untimed(H5P_GROUP_CREATE, where);
+  for (const auto& [other, table] : w.tables) {
+    if (name.rfind(other + "/", 0) == 0 || other.rfind(name + "/", 0) == 0) {
+      throw TraceError(w.context() + ": table " + quoted("/" + name) + " would nest in table " +
+                       quoted("/" + other));
+    }
+  }
   auto impl = std::make_unique<TraceTable::Impl>();
   impl->file = &w.state;
   impl->file_path = w.path;
-  impl->group_path = "/" + name;
-  impl->options = w.options;
+  impl->name = name;
   impl->block_rows = block_rows > 0 ? block_rows : w.options.block_rows;
-  impl->group = h5::checked(
-      H5Gcreate2(w.root.get(), name.c_str(), lcpl.get(), gcpl.get(), H5P_DEFAULT), H5Gclose,
-      where);
   auto table = std::unique_ptr<TraceTable>(new TraceTable(std::move(impl)));
   return *w.tables.emplace(name, std::move(table)).first->second;
 }
@@ -429,6 +679,7 @@ void TraceWriter::Impl::set_root_attribute(const std::string& name,
                                            std::function<void(hid_t)> write) {
   require_open();
   if (!state.frozen) {
+    h5::Lock lock;
     h5::Quiet quiet;
     write(root.get());
     return;
@@ -457,31 +708,66 @@ void TraceWriter::set_attribute(const std::string& name, std::int64_t value) {
 }
 
 void TraceWriter::flush() {
+  Impl& w = *impl_;
+  w.require_open();
+  if (!w.state.frozen) {
+    h5::Lock lock;
+    h5::Quiet quiet;
+    h5::check(H5Fflush(w.file.get(), H5F_SCOPE_LOCAL), w.context() + ": cannot flush");
+    return;
+  }
+  for (auto& [name, table] : w.tables) {
+    if (table->impl_->started) table->impl_->hand_over();
+  }
+  w.state.worker.submit(Job{nullptr});
+}
+
+void TraceWriter::wait() {
   impl_->require_open();
-  h5::Quiet quiet;
-  for (auto& [name, table] : impl_->tables) table->impl_->write_block();
-  h5::check(H5Fflush(impl_->file.get(), H5F_SCOPE_LOCAL), impl_->context() + ": cannot flush");
+  if (impl_->state.frozen) impl_->state.worker.drain();
 }
 
 void TraceWriter::close(const std::string& status) {
   Impl& w = *impl_;
   if (w.closed) return;
   w.closed = true;
-  h5::Quiet quiet;
   std::string failure;
-  for (auto& [name, table] : w.tables) {
+  if (!w.state.frozen && !w.tables.empty()) {
+    // No row was ever appended: the tables are still created, with 0 rows.
     try {
-      table->impl_->write_block();
+      w.freeze();
     } catch (const TraceError& e) {
-      if (failure.empty()) failure = e.what();
+      failure = e.what();
     }
   }
+  if (w.state.frozen) {
+    for (auto& [name, table] : w.tables) {
+      try {
+        if (table->impl_->started) table->impl_->hand_over();
+      } catch (const TraceError& e) {
+        if (failure.empty()) failure = e.what();
+      } catch (...) {
+      }
+    }
+    w.state.worker.stop();
+    if (const std::exception_ptr e = w.state.worker.failure(); e && failure.empty()) {
+      try {
+        std::rethrow_exception(e);
+      } catch (const std::exception& error) {
+        failure = error.what();
+      } catch (...) {
+        failure = w.context() + ": unknown failure while writing";
+      }
+    }
+  }
+  h5::Lock lock;
+  h5::Quiet quiet;
   // Every object of the file is closed before the file itself, so H5Fclose really closes it
   // (and ends SWMR writing, clearing the superblock's status flags).
   for (auto& [name, table] : w.tables) {
     table->impl_->closed = true;
-    for (Column& column : table->impl_->columns) column.dataset.reset();
-    table->impl_->group.reset();
+    table->impl_->dataset.reset();
+    table->impl_->memory_type.reset();
   }
   w.root.reset();
   if (w.file.close() < 0 && failure.empty()) {

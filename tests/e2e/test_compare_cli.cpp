@@ -12,6 +12,7 @@
 #include <string>
 #include <sys/wait.h>
 #include "tests/support/shell.hpp"
+#include "tests/support/trace_edit.hpp"
 
 namespace {
 
@@ -34,26 +35,9 @@ void run_lift(const std::string& out, const std::string& extra = "") {
   REQUIRE(std::filesystem::exists(out));
 }
 
-// Adds `delta` to element (row, column) of dataset `path`, returning the new value.
+// Adds `delta` to element (row, column) of column `path`, returning the new value.
 double nudge(const std::string& file, const std::string& path, hsize_t row, hsize_t column, double delta) {
-  const hid_t f = H5Fopen(file.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
-  REQUIRE(f >= 0);
-  const hid_t d = H5Dopen2(f, path.c_str(), H5P_DEFAULT);
-  REQUIRE(d >= 0);
-  const hid_t space = H5Dget_space(d);
-  const hsize_t offset[2] = {row, column};
-  const hsize_t count[2] = {1, 1};
-  REQUIRE(H5Sselect_hyperslab(space, H5S_SELECT_SET, offset, nullptr, count, nullptr) >= 0);
-  const hid_t memory = H5Screate_simple(2, count, nullptr);
-  double value = 0.0;
-  REQUIRE(H5Dread(d, H5T_NATIVE_DOUBLE, memory, space, H5P_DEFAULT, &value) >= 0);
-  value += delta;
-  REQUIRE(H5Dwrite(d, H5T_NATIVE_DOUBLE, memory, space, H5P_DEFAULT, &value) >= 0);
-  H5Sclose(memory);
-  H5Sclose(space);
-  H5Dclose(d);
-  H5Fclose(f);
-  return value;
+  return graspsim::test::add_to_element(file, path, row, column, delta);
 }
 
 // A minimal JSON syntax checker (RFC 8259 grammar; numbers loosely): true if `text` is one
@@ -214,12 +198,7 @@ TEST_CASE("graspsim compare refuses unusable input with exit status 2", "[compar
   const std::string fewer = kTmp + "/compare_cli_fewer.h5";
   std::filesystem::remove(fewer);
   std::filesystem::copy_file(a, fewer);
-  {
-    const hid_t f = H5Fopen(fewer.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
-    REQUIRE(f >= 0);
-    REQUIRE(H5Ldelete(f, "/physics/objects/box/torque", H5P_DEFAULT) >= 0);
-    H5Fclose(f);
-  }
+  graspsim::test::drop_column(fewer, "/physics", "objects/box/torque");
 
   struct Case { std::string args; std::vector<std::string> says; };
   const std::vector<Case> cases = {

@@ -1,6 +1,6 @@
-// The schema document matches what is written: every dataset and attribute of a real trace is
-// in recordings/README.md's tables (same shape, dtype, units, type), and everything the tables
-// list is in the trace. Parses the README; fails when the two disagree, naming the difference.
+// The schema document matches what is written: every column (a member of a table's compound
+// rows) and attribute of a real trace is in recordings/README.md's tables (same shape, dtype,
+// units, type), and everything the tables list is in the trace. Parses the README; fails when the two disagree, naming the difference.
 #include <catch2/catch.hpp>
 #include <hdf5.h>
 
@@ -118,16 +118,22 @@ std::string string_attribute(hid_t attribute) {
   return value;
 }
 
+// An attribute of a table dataset named "<column>/<name>" belongs to that column (schema 3);
+// "units" of every column is listed once, as "every column".
 herr_t on_attribute(hid_t object, const char* name, const H5A_info_t*, void* data) {
   Found& f = *static_cast<Found*>(data);
   hid_t attribute = H5Aopen(object, name, H5P_DEFAULT);
   hid_t type = H5Aget_type(attribute);
   const std::string type_str = type_name(type);
   H5Tclose(type);
-  if (f.current_is_dataset && std::string(name) == "units") {
-    f.attributes.insert({"every dataset", "units", type_str});
+  const std::string n = name;
+  const auto slash = n.rfind('/');
+  if (f.current_is_dataset && slash != std::string::npos) {
+    const std::string column = f.current + "/" + n.substr(0, slash), key = n.substr(slash + 1);
+    if (key == "units") f.attributes.insert({"every column", "units", type_str});
+    else f.attributes.insert({generic(column), key, type_str});
   } else {
-    f.attributes.insert({generic(f.current), name, type_str});
+    f.attributes.insert({generic(f.current), n, type_str});
   }
   H5Aclose(attribute);
   return 0;
@@ -141,22 +147,42 @@ herr_t on_object(hid_t root, const char* name, const H5O_info_t* info, void* dat
   f.current = path;
   f.current_is_dataset = info->type == H5O_TYPE_DATASET;
   if (f.current_is_dataset) {
+    // A table: one compound dataset of shape (n); each member is a column, an array member
+    // of width w a column of shape (n,w); its units are attribute "<member>/units".
     hid_t space = H5Dget_space(object);
-    hsize_t dims[2] = {0, 0};
-    const int rank = H5Sget_simple_extent_dims(space, dims, nullptr);
+    const int rank = H5Sget_simple_extent_ndims(space);
     H5Sclose(space);
-    hid_t type = H5Dget_type(object);
-    std::string units = "(none)";
-    if (H5Aexists(object, "units") > 0) {
-      hid_t a = H5Aopen(object, "units", H5P_DEFAULT);
-      units = string_attribute(a);
-      H5Aclose(a);
-    } else {
-      f.units_missing.push_back(path);
+    hid_t row = H5Dget_type(object);
+    if (rank != 1 || H5Tget_class(row) != H5T_COMPOUND) f.datasets.insert({generic(path), "not a table", "?", "?"});
+    const int members = H5Tget_class(row) == H5T_COMPOUND ? H5Tget_nmembers(row) : 0;
+    for (int k = 0; k < members; ++k) {
+      char* member_name = H5Tget_member_name(row, static_cast<unsigned>(k));
+      const std::string member = member_name;
+      H5free_memory(member_name);
+      hid_t type = H5Tget_member_type(row, static_cast<unsigned>(k));
+      std::string shape = "(n)";
+      hid_t base = H5Tcopy(type);
+      if (H5Tget_class(type) == H5T_ARRAY) {
+        hsize_t width = 0;
+        H5Tget_array_dims2(type, &width);
+        shape = "(n," + std::to_string(width) + ")";
+        H5Tclose(base);
+        base = H5Tget_super(type);
+      }
+      std::string units = "(none)";
+      const std::string key = member + "/units";
+      if (H5Aexists(object, key.c_str()) > 0) {
+        hid_t a = H5Aopen(object, key.c_str(), H5P_DEFAULT);
+        units = string_attribute(a);
+        H5Aclose(a);
+      } else {
+        f.units_missing.push_back(path + "/" + member);
+      }
+      f.datasets.insert({generic(path + "/" + member), shape, type_name(base), units});
+      H5Tclose(base);
+      H5Tclose(type);
     }
-    f.datasets.insert({generic(path), rank == 1 ? "(n)" : "(n," + std::to_string(dims[1]) + ")",
-                       type_name(type), units});
-    H5Tclose(type);
+    H5Tclose(row);
   }
   H5Aiterate2(object, H5_INDEX_NAME, H5_ITER_INC, nullptr, on_attribute, &f);
   H5Oclose(object);
@@ -198,7 +224,7 @@ TEST_CASE("recordings/README.md documents exactly the datasets and attributes of
   // The README's tables.
   std::set<DatasetRow> documented;
   std::string group;
-  for (const auto& row : table("| group | dataset |")) {
+  for (const auto& row : table("| table | column |")) {
     REQUIRE(row.size() >= 5);
     if (!row[0].empty()) group = code(row[0]);
     documented.insert({group + "/" + code(row[1]), row[2], row[3], row[4]});

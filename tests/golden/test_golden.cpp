@@ -17,6 +17,7 @@
 #include "graspsim/recordings/trace_reader.hpp"
 #include "graspsim/scripting/scenario.hpp"
 #include "tests/support/shell.hpp"
+#include "tests/support/trace_edit.hpp"
 
 namespace fs = std::filesystem;
 using namespace graspsim;
@@ -38,22 +39,9 @@ std::vector<std::string> scenario_files() {
 using graspsim::test::Outcome;
 using graspsim::test::shell;
 
-// Adds `delta` to element (row, component) of a float64 dataset, in place.
+// Adds `delta` to element (row, component) of a float64 column, in place.
 void perturb(const std::string& file, const std::string& path, hsize_t row, hsize_t component, double delta) {
-  const hid_t f = H5Fopen(file.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
-  REQUIRE(f >= 0);
-  const hid_t d = H5Dopen2(f, path.c_str(), H5P_DEFAULT);
-  REQUIRE(d >= 0);
-  const hid_t space = H5Dget_space(d);
-  hsize_t dims[2] = {0, 1};
-  H5Sget_simple_extent_dims(space, dims, nullptr);
-  std::vector<double> values(dims[0] * dims[1]);
-  REQUIRE(H5Dread(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, values.data()) >= 0);
-  values.at(row * dims[1] + component) += delta;
-  REQUIRE(H5Dwrite(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, values.data()) >= 0);
-  H5Sclose(space);
-  H5Dclose(d);
-  H5Fclose(f);
+  graspsim::test::add_to_element(file, path, row, component, delta);
 }
 
 // Replaces the root string attribute `name` (a golden "written elsewhere").

@@ -19,6 +19,7 @@
 
 #include "graspsim/recordings/trace_compare.hpp"
 #include "graspsim/recordings/trace_writer.hpp"
+#include "tests/support/trace_edit.hpp"
 
 using namespace graspsim::recordings;
 
@@ -99,44 +100,8 @@ void make_trace(const std::string& path, const Spec& s) {
   w.close("complete");
 }
 
-// Writes `value` into element (row, column) of dataset `path` of an existing file.
-void set_element(const std::string& file, const std::string& path, hsize_t row, hsize_t column,
-                 double value) {
-  const hid_t f = H5Fopen(file.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
-  REQUIRE(f >= 0);
-  const hid_t d = H5Dopen2(f, path.c_str(), H5P_DEFAULT);
-  REQUIRE(d >= 0);
-  const hid_t space = H5Dget_space(d);
-  const int rank = H5Sget_simple_extent_ndims(space);
-  const hsize_t offset[2] = {row, column};
-  const hsize_t count[2] = {1, 1};
-  REQUIRE(H5Sselect_hyperslab(space, H5S_SELECT_SET, offset, nullptr, count, nullptr) >= 0);
-  const hid_t memory = H5Screate_simple(rank, count, nullptr);
-  REQUIRE(H5Dwrite(d, H5T_NATIVE_DOUBLE, memory, space, H5P_DEFAULT, &value) >= 0);
-  H5Sclose(memory);
-  H5Sclose(space);
-  H5Dclose(d);
-  H5Fclose(f);
-}
-
-double get_element(const std::string& file, const std::string& path, hsize_t row, hsize_t column) {
-  const hid_t f = H5Fopen(file.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
-  REQUIRE(f >= 0);
-  const hid_t d = H5Dopen2(f, path.c_str(), H5P_DEFAULT);
-  const hid_t space = H5Dget_space(d);
-  const int rank = H5Sget_simple_extent_ndims(space);
-  const hsize_t offset[2] = {row, column};
-  const hsize_t count[2] = {1, 1};
-  H5Sselect_hyperslab(space, H5S_SELECT_SET, offset, nullptr, count, nullptr);
-  const hid_t memory = H5Screate_simple(rank, count, nullptr);
-  double value = 0.0;
-  REQUIRE(H5Dread(d, H5T_NATIVE_DOUBLE, memory, space, H5P_DEFAULT, &value) >= 0);
-  H5Sclose(memory);
-  H5Sclose(space);
-  H5Dclose(d);
-  H5Fclose(f);
-  return value;
-}
+using graspsim::test::get_element;
+using graspsim::test::set_element;
 
 // A pair of identical traces, A and B.
 std::pair<std::string, std::string> twins(const std::string& name, const Spec& s = {}) {

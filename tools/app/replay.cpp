@@ -9,6 +9,7 @@
 
 #include "graspsim/hw/replay_device.hpp"
 #include "graspsim/recordings/trace_reader.hpp"
+#include "graspsim/recordings/trace_recorder.hpp"
 
 namespace graspsim::app {
 namespace {
@@ -64,9 +65,10 @@ ReplayPlan load(const std::string& trace, const ReplayOptions& options) {
                       " records no device inputs (/servo/fingers/<finger>/gimbal, /physics/state_hash "
                       "came with schema 2): it cannot be replayed; run its scenario again to record them");
   }
-  if (schema > 2) {
+  if (schema > recordings::kSchemaVersion) {
     throw ReplayError(trace + ": schema_version " + std::to_string(schema) +
-                      " is newer than this graspsim reads (2)");
+                      " is newer than this graspsim reads (" +
+                      std::to_string(recordings::kSchemaVersion) + ")");
   }
   plan.status = required_string(trace, "status");
   plan.scenario_path = required_string(trace, "scenario_path");

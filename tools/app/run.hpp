@@ -28,6 +28,9 @@ struct RunOptions {
   // `overrides` attribute: with the scenario source they reload the same scenario (replay).
   std::vector<std::string> overrides;
   bool write_trace = true;   // false: no trace at all (the logging benchmark's baseline)
+  // true: HDF5 writing runs on a writer thread (TraceOptions::background); false: on the run
+  // loop's thread (the logging benchmark compares the two). The trace is the same.
+  bool background_writer = true;
   // Replay (tools/app/replay.hpp): the device of finger f instead of its scripted trajectory
   // (empty: scripted); at most `max_ticks` servo ticks (< 0: the scenario's duration; expectations
   // due later are reported as not checked); extra root string attributes (`replay_of`).

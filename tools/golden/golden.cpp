@@ -195,6 +195,20 @@ std::vector<std::int64_t> read_ticks(hid_t group, const std::string& where) {
   return ticks;
 }
 
+// The "tick" member of a compound table (schema 3), or an empty optional-like flag if it has none.
+bool read_table_ticks(hid_t dataset, const std::string& where, std::vector<std::int64_t>& ticks) {
+  const std::string context = "cannot read " + where;
+  Id type(H5Dget_type(dataset), H5Tclose, context);
+  if (H5Tget_class(type.get()) != H5T_COMPOUND || H5Tget_member_index(type.get(), "tick") < 0) return false;
+  Id space(H5Dget_space(dataset), H5Sclose, context);
+  ticks.assign(static_cast<std::size_t>(H5Sget_simple_extent_npoints(space.get())), 0);
+  Id tick_type(H5Tcreate(H5T_COMPOUND, sizeof(std::int64_t)), H5Tclose, context);
+  check(H5Tinsert(tick_type.get(), "tick", 0, H5T_NATIVE_INT64), context);
+  if (!ticks.empty())
+    check(H5Dread(dataset, tick_type.get(), H5S_ALL, H5S_ALL, H5P_DEFAULT, ticks.data()), context);
+  return true;
+}
+
 std::string format(const char* fmt, auto... args) {
   char buffer[512];
   std::snprintf(buffer, sizeof buffer, fmt, args...);
@@ -246,9 +260,20 @@ void decimate_trace(const std::string& in, const std::string& out, const Decimat
     for (const std::string& name : link_names(src.get(), where)) {
       const std::string path = "/" + name;
       const std::string context = "cannot copy " + path + " of " + where;
-      Id group(H5Gopen2(src.get(), name.c_str(), H5P_DEFAULT), H5Gclose, context);
+      Id object(H5Oopen(src.get(), name.c_str(), H5P_DEFAULT), H5Oclose, context);
       std::vector<hsize_t> rows;
-      const bool decimated = (name == "servo" || name == "haptic") && H5Lexists(group.get(), "tick", H5P_DEFAULT) > 0;
+      const bool loop = name == "servo" || name == "haptic";
+      if (H5Iget_type(object.get()) == H5I_DATASET) {
+        // Schema 3: the loop is one compound dataset; its rows are decimated by its tick member.
+        std::vector<std::int64_t> ticks;
+        const bool decimated = loop && read_table_ticks(object.get(), path + " of " + where, ticks);
+        for (std::size_t r = 0; r < ticks.size() && decimated; ++r)
+          if (ticks[r] % stride == 0) rows.push_back(r);
+        copier.dataset(src.get(), dst.get(), name, path, decimated ? &rows : nullptr);
+        continue;
+      }
+      Id group(H5Gopen2(src.get(), name.c_str(), H5P_DEFAULT), H5Gclose, context);
+      const bool decimated = loop && H5Lexists(group.get(), "tick", H5P_DEFAULT) > 0;
       if (decimated) {
         const std::vector<std::int64_t> ticks = read_ticks(group.get(), path + "/tick of " + where);
         for (std::size_t r = 0; r < ticks.size(); ++r)

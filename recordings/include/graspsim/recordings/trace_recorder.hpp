@@ -14,6 +14,11 @@
 
 namespace graspsim::recordings {
 
+// The trace schema this graspsim writes (root attribute "schema_version", recordings/README.md).
+// 3: one compound dataset per loop (/servo, /haptic, /physics), one member per column.
+// 2: one group per loop, one dataset per column. Readers here read both.
+inline constexpr std::int64_t kSchemaVersion = 3;
+
 class TraceRecorder {
  public:
   // Declares every table and column (and their attributes) in `writer`, which must outlive

@@ -1,5 +1,6 @@
-// TraceWriter: writes a run's trace as an HDF5 file of tables, each a group of datasets that
-// grow one row at a time together, buffered in blocks and appended to chunked datasets.
+// TraceWriter: writes a run's trace as an HDF5 file of tables, each one chunked dataset of
+// compound rows (one member per column) that grows one row at a time, buffered in blocks and
+// appended block by block, optionally by a background writer thread.
 #pragma once
 
 #include <bit>
@@ -27,41 +28,46 @@ enum class DType { kFloat64, kInt64, kInt32, kInt8, kUInt64 };
 // (written back bit for bit; never do arithmetic on it).
 inline double uint64_in_row(std::uint64_t value) { return std::bit_cast<double>(value); }
 
-// A group of datasets that grow together: one append_row() adds one row to every dataset of
-// the group at once, so they can never drift apart (the H5MD lesson). Owned by a TraceWriter.
+// A table: one HDF5 dataset of compound rows, one member per column, so its columns can never
+// drift apart, not even in a file cut by a crash (the H5MD lesson, taken one step further than
+// a group of datasets). Owned by a TraceWriter.
 class TraceTable {
  public:
+  struct Impl;   // opaque
   ~TraceTable();
   TraceTable(const TraceTable&) = delete;
   TraceTable& operator=(const TraceTable&) = delete;
 
-  // Declares dataset `path` (relative to the group, may contain '/', e.g.
-  // "fingers/thumb/hip"; intermediate groups are created) with `width` values per row: width 1
-  // gives shape (n,), width > 1 gives (n, width). Stored as `dtype`, with string attribute
-  // "units" = units. The dataset is created at once with 0 rows. Returns the column's offset
-  // into a row. Only allowed before the first row of any table of the file (the layout is then
-  // frozen for SWMR); throws TraceError after it, for a bad path, a path used twice, or width < 1.
+  // Declares column `path` (relative to the table, may contain '/', e.g. "fingers/thumb/hip"):
+  // a member of that name of the row type, with `width` values per row (width > 1: an array
+  // member), stored as `dtype`; the table gets string attribute "<path>/units" = units. Readers
+  // see it as dataset "/<table>/<path>" of shape (n,) or (n, width) (trace_reader.hpp). Returns
+  // the column's offset into a row. Only allowed before the first row of any table of the file
+  // (the layout is then frozen for SWMR); throws TraceError after it, for a bad path, a path
+  // used twice, or width < 1.
   std::size_t add_column(const std::string& path, int width, DType dtype,
                          const std::string& units);
   // Pointer to the next row: row_width() doubles in column order; the caller fills all of them.
   // Valid until the next append_row/flush. Integer columns are stored as doubles in the row and
-  // converted on flush (exact up to 2^53); a value that is not an integer in the column's range
-  // makes the flush throw TraceError naming the dataset and row. Writes the buffered block when
-  // it is full (then also flushes the file's metadata, so a run cut short leaves a readable
-  // file). The first row of any table freezes the file's layout and, with TraceOptions::swmr,
-  // starts SWMR writing. Allocates only on the first call.
+  // converted when the block is written (exact up to 2^53); a value that is not an integer in
+  // the column's range makes that write fail with a TraceError naming the column and row (with
+  // TraceOptions::background, thrown by a later call: the next hand-over, wait() or close()).
+  // Hands the block to the writer when it is full (then also flushes the file's metadata, so a
+  // run cut short leaves a readable file). The first row of any table freezes the file's layout:
+  // every table's dataset is created and, with TraceOptions::swmr, SWMR writing starts.
+  // Allocates only on the first call.
   double* append_row();
   std::size_t row_width() const;   // doubles per row
   std::int64_t rows() const;       // rows appended so far (flushed or not)
-  void flush();                    // writes buffered rows (no-op if none)
-  // String attribute on a dataset or group below this table's group; "." = the group itself.
-  // Only before the file's first row (throws TraceError after it).
+  void flush();                    // writes buffered rows and waits for the writer
+  // String attribute of the table ("."; stored as attribute `name` of the dataset) or of one of
+  // its columns (stored as attribute "<column>/<name>"). Only before the file's first row
+  // (throws TraceError after it, for an unknown column, or a name that is empty or has '/').
   void set_attribute(const std::string& dataset_or_dot, const std::string& name,
                      const std::string& value);
 
  private:
   friend class TraceWriter;
-  struct Impl;
   explicit TraceTable(std::unique_ptr<Impl> impl);
   std::unique_ptr<Impl> impl_;
 };
@@ -74,6 +80,10 @@ struct TraceOptions {
   // row on, so a process killed at any moment leaves every flushed row readable. false: the
   // default (oldest compatible) format, no SWMR.
   bool swmr = true;
+  // Writes blocks and flushes on a background thread, in the order they were handed over, so the
+  // thread that appends rows only fills memory (it waits only when the writer is 4 blocks per
+  // table behind). Errors surface at a later call. The file is the same either way.
+  bool background = false;
 };
 
 class TraceWriter {
@@ -88,8 +98,9 @@ class TraceWriter {
   TraceWriter(const TraceWriter&) = delete;
   TraceWriter& operator=(const TraceWriter&) = delete;
 
-  // The table of group `group` ("servo" or "/servo"; may be nested, "a/b"), created on first
-  // use (only before the file's first row); the same object afterwards. References stay valid
+  // The table at dataset path `group` ("servo" or "/servo"; may be below a group, "a/b", but not
+  // below another table), created on first use (only before the file's first row); the same
+  // object afterwards. References stay valid
   // until the writer is destroyed. `block_rows`: rows this table buffers before a write, which
   // are also its rows per chunk (0: TraceOptions::block_rows); used only when the table is
   // created. A writer that flushes every N rows of a table should give it N (a flush then writes
@@ -107,7 +118,11 @@ class TraceWriter {
   void set_attribute(const std::string& name, T value) {
     set_attribute(name, static_cast<std::int64_t>(value));
   }
-  void flush();   // every table, then H5Fflush
+  // Hands every table's buffered rows to the writer, then an H5Fflush (done by the time this
+  // returns without TraceOptions::background; with it, queued: see wait()).
+  void flush();
+  // Waits until everything handed to the writer is on disk; rethrows a failure of the writer.
+  void wait();
   // Flushes, closes the file, reopens it without SWMR, writes the kept root attributes and
   // root string attribute "status" (e.g. "complete" or "error: <message>") and closes it. Idempotent: later calls do nothing. If the flush fails the status
   // written is "error: <flush failure>", the file is still closed, and TraceError is thrown.
