@@ -4,7 +4,7 @@
 -- cube_settle's 10 cm, 0.5 kg cube, dropped corner first from 1 cm, onto a floor a thousand times
 -- stiffer (100 kN/m per vertex, 20 N s/m) with physics at 1 kHz. The explicit (symplectic Euler)
 -- step is stable for a contact mode while h^2 K / M < 4 - 2 h C / M; the benchmark's bisection puts
--- the largest stable stiffness for this drop at 3.0e5 N/m at 1 kHz (and 830 N/m at the paper's
+-- the largest stable stiffness for this drop at 2.8e5 N/m at 1 kHz (and 760 N/m at the paper's
 -- 50 Hz), so 1e5 is stable: the cube lands, rotates down onto a face and rests m g / (4 k) = 12 um
 -- deep. It keeps a period-2 tangential cycle: its centre alternates by 2.4 um between two points
 -- every physics step (1.7 mm/s), the floor's friction anchors slipping in a friction circle only

@@ -50,7 +50,7 @@ def number(text):
 def work_precision(rows, out):
     cases = list(dict.fromkeys(r["case"] for r in rows))
     if not cases:
-        return
+        return []
     cols = 2 if len(cases) > 1 else 1
     nrows = (len(cases) + cols - 1) // cols
     fig, axes = plt.subplots(nrows, cols, figsize=(5.2 * cols, 4.0 * nrows), squeeze=False)
@@ -89,11 +89,12 @@ def work_precision(rows, out):
     fig.tight_layout(rect=(0, 0.05, 1, 0.96))
     fig.savefig(out, dpi=80)
     plt.close(fig)
+    return [out]
 
 
 def stability(rows, out):
     if not rows:
-        return
+        return []
     fig, ax = plt.subplots(figsize=(5.5, 4.0))
     for integrator, (colour, marker) in STYLE.items():
         pts = sorted((int(r["rate_hz"]), number(r["k_max_n_per_m"])) for r in rows if r["integrator"] == integrator)
@@ -112,6 +113,7 @@ def stability(rows, out):
     fig.tight_layout()
     fig.savefig(out, dpi=80)
     plt.close(fig)
+    return [out]
 
 
 def main():
@@ -121,9 +123,8 @@ def main():
     bench = read(f"{d}/bench.csv", ["case", "rate_hz", "integrator", "status", "wall_per_sim_s", "error",
                                     "error_measure"])
     stab = read(f"{d}/stability.csv", ["rate_hz", "integrator", "k_max_n_per_m", "estimate_n_per_m"])
-    work_precision(bench, f"{d}/work_precision.png")
-    stability(stab, f"{d}/stability.png")
-    print(f"wrote {d}/work_precision.png and {d}/stability.png")
+    written = work_precision(bench, f"{d}/work_precision.png") + stability(stab, f"{d}/stability.png")
+    print("wrote " + (" and ".join(written) if written else "nothing (no rows)"))
 
 
 if __name__ == "__main__":

@@ -112,7 +112,7 @@ TEST_CASE("a fast top on a finger precesses at the analytic rate", "[bench][law]
 // Corner drop on a penalty floor, explicit (symplectic Euler) integration: a contact mode of
 // stiffness K and inertia M is stable for h^2 K / M < 4 - 2 h C / M. stability_warnings' estimate
 // (rocking on four corners, K / M = 12 k / m) must be on the safe side: the bench's bisection
-// finds the largest stable k at or above it at every rate (measured 1.4 to 2.6 x), and within
+// finds the largest stable k at or above it at every rate (measured 1.4 to 2.4 x), and within
 // 4 x of it (the estimate is the right law, not a loose bound). Where damping is negligible
 // (500 Hz and up) the boundary scales as 1 / h^2: k(3000) / k(500) within a factor 2 of 36.
 // At half the estimate every run keeps its energy (no NaN, no divergence, no gain above m g
