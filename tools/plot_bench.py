@@ -1,0 +1,131 @@
+#!/usr/bin/python3
+"""Charts of graspsim_bench's output (README.md, "Speed against error").
+
+    tools/plot_bench.py DIR     reads DIR/bench.csv and DIR/stability.csv, writes
+                                DIR/work_precision.png and DIR/stability.png
+
+work_precision.png: error against cost (wall seconds per simulated second), log-log, one panel
+per case and one curve per gyroscopic option, each point labelled with its physics rate in Hz.
+Unstable runs are drawn as red crosses (at the panel's top edge when their error is not finite);
+the finest rate of a convergence case is its own reference (error 0) and is left out.
+stability.png: the corner drop's largest stable floor stiffness against the physics rate, with
+the rocking-mode estimate. Exit 2, nothing written, when a file is missing or malformed.
+Needs Debian's python3-matplotlib (run with /usr/bin/python3).
+"""
+import csv
+import math
+import sys
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+STYLE = {"neglect": ("tab:blue", "o"), "explicit": ("tab:orange", "s"), "implicit": ("tab:green", "^")}
+
+
+def fail(message):
+    print(f"plot_bench: {message}", file=sys.stderr)
+    sys.exit(2)
+
+
+def read(path, columns):
+    try:
+        with open(path, newline="") as f:
+            rows = list(csv.DictReader(f))
+    except OSError as e:
+        fail(f"{path}: {e.strerror}")
+    if rows and not set(columns) <= set(rows[0].keys()):
+        fail(f"{path}: expected columns {', '.join(columns)}")
+    return rows
+
+
+def number(text):
+    try:
+        return float(text)
+    except ValueError:
+        return math.nan
+
+
+def work_precision(rows, out):
+    cases = list(dict.fromkeys(r["case"] for r in rows))
+    if not cases:
+        return []
+    cols = 2 if len(cases) > 1 else 1
+    nrows = (len(cases) + cols - 1) // cols
+    fig, axes = plt.subplots(nrows, cols, figsize=(5.2 * cols, 4.0 * nrows), squeeze=False)
+    for ax, case in zip(axes.flat, cases):
+        mine = [r for r in rows if r["case"] == case]
+        finite = [number(r["error"]) for r in mine if 0 < number(r["error"]) < math.inf]
+        top = max(finite) * 3 if finite else 1.0
+        for integrator, (colour, marker) in STYLE.items():
+            pts = [r for r in mine if r["integrator"] == integrator and number(r["error"]) != 0]
+            pts.sort(key=lambda r: int(r["rate_hz"]))
+            ok = [r for r in pts if r["status"] == "ok"]
+            ax.plot([number(r["wall_per_sim_s"]) for r in ok], [number(r["error"]) for r in ok],
+                    marker=marker, color=colour, label=integrator, linewidth=1, markersize=5)
+            for r in pts:
+                err = number(r["error"])
+                y = err if 0 < err < math.inf else top
+                x = number(r["wall_per_sim_s"])
+                if r["status"] != "ok":
+                    ax.plot([x], [y], marker="x", color="red", markersize=8, markeredgewidth=2, linestyle="none")
+                ax.annotate(r["rate_hz"], (x, y), textcoords="offset points", xytext=(3, 3), fontsize=6,
+                            color=colour)
+        ax.set_xscale("log")
+        ax.set_yscale("log")
+        ax.set_title(case, fontsize=10)
+        ax.set_xlabel("wall s per simulated s (median)", fontsize=8)
+        ax.set_ylabel(mine[0]["error_measure"] if mine else "error", fontsize=8)
+        ax.tick_params(labelsize=7)
+        ax.grid(True, which="both", linewidth=0.3)
+    for ax in list(axes.flat)[len(cases):]:
+        ax.axis("off")
+    handles, labels = axes.flat[0].get_legend_handles_labels()
+    handles.append(plt.Line2D([], [], marker="x", color="red", linestyle="none", markeredgewidth=2))
+    labels.append("unstable")
+    fig.legend(handles, labels, loc="lower center", ncol=4, fontsize=8)
+    fig.suptitle("graspsim work-precision (labels: physics rate, Hz)", fontsize=11)
+    fig.tight_layout(rect=(0, 0.05, 1, 0.96))
+    fig.savefig(out, dpi=80)
+    plt.close(fig)
+    return [out]
+
+
+def stability(rows, out):
+    if not rows:
+        return []
+    fig, ax = plt.subplots(figsize=(5.5, 4.0))
+    for integrator, (colour, marker) in STYLE.items():
+        pts = sorted((int(r["rate_hz"]), number(r["k_max_n_per_m"])) for r in rows if r["integrator"] == integrator)
+        ax.plot([p[0] for p in pts], [p[1] for p in pts], marker=marker, color=colour, label=f"measured, {integrator}",
+                linewidth=1, markersize=5)
+    est = sorted({(int(r["rate_hz"]), number(r["estimate_n_per_m"])) for r in rows})
+    ax.plot([p[0] for p in est], [p[1] for p in est], "k--", linewidth=1, label="estimate (rocking mode)")
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel("physics rate (Hz)", fontsize=8)
+    ax.set_ylabel("largest stable floor stiffness (N/m per vertex)", fontsize=8)
+    ax.set_title("corner drop: stability boundary", fontsize=10)
+    ax.tick_params(labelsize=7)
+    ax.grid(True, which="both", linewidth=0.3)
+    ax.legend(fontsize=7)
+    fig.tight_layout()
+    fig.savefig(out, dpi=80)
+    plt.close(fig)
+    return [out]
+
+
+def main():
+    if len(sys.argv) != 2 or sys.argv[1].startswith("-"):
+        fail("usage: plot_bench.py DIR (with DIR/bench.csv and DIR/stability.csv)")
+    d = sys.argv[1]
+    bench = read(f"{d}/bench.csv", ["case", "rate_hz", "integrator", "status", "wall_per_sim_s", "error",
+                                    "error_measure"])
+    stab = read(f"{d}/stability.csv", ["rate_hz", "integrator", "k_max_n_per_m", "estimate_n_per_m"])
+    written = work_precision(bench, f"{d}/work_precision.png") + stability(stab, f"{d}/stability.png")
+    print("wrote " + (" and ".join(written) if written else "nothing (no rows)"))
+
+
+if __name__ == "__main__":
+    main()
