@@ -115,6 +115,13 @@ struct Column {
   std::size_t bytes;     // bytes into a packed compound row
 };
 
+// Consecutive 8-byte columns copied as they are (float64, and uint64 bits): one memcpy per row.
+struct CopyRun {
+  std::size_t offset;   // doubles into a row of the block buffer
+  std::size_t bytes;    // bytes into a packed row
+  std::size_t count;    // doubles
+};
+
 // Object creation properties without modification times, so that two runs write the same
 // object headers.
 h5::Handle untimed(hid_t property_class, const std::string& where) {
@@ -289,6 +296,9 @@ struct TraceTable::Impl {
   // Writer side.
   h5::Handle dataset;
   h5::Handle memory_type;        // the compound row in memory (native types, packed)
+  std::vector<CopyRun> runs;     // the 8-byte columns, merged where adjacent
+  std::vector<const Column*> integers;   // the columns converted and checked one by one
+  bool direct = false;           // whole chunks go to the file as they are (H5Dwrite_chunk)
   std::vector<unsigned char> packed;   // block_rows x packed_width
   std::int64_t written = 0;      // rows on disk
 
@@ -426,6 +436,26 @@ void TraceTable::Impl::create_dataset(hid_t file_id) {
   if (columns.empty()) throw TraceError(where + ": it has no columns");
   h5::Handle file_type = row_type(columns, packed_width, false, where);
   memory_type = row_type(columns, packed_width, true, where);
+  // A whole chunk is written straight to the file, past the chunk cache (a copy and its
+  // bookkeeping saved), when the packed rows are the file's bytes: no filter, no conversion.
+  const htri_t same = H5Tequal(file_type.get(), memory_type.get());
+  h5::check(same, where);
+  direct = same > 0 && file->options.compression == 0;
+  runs.clear();
+  integers.clear();
+  for (const Column& c : columns) {
+    if (c.dtype == DType::kFloat64 || c.dtype == DType::kUInt64) {
+      const std::size_t w = static_cast<std::size_t>(c.width);
+      if (!runs.empty() && runs.back().offset + runs.back().count == c.offset &&
+          runs.back().bytes + 8 * runs.back().count == c.bytes) {
+        runs.back().count += w;
+      } else {
+        runs.push_back(CopyRun{c.offset, c.bytes, w});
+      }
+    } else {
+      integers.push_back(&c);
+    }
+  }
   // Shape (0,), unlimited rows, one chunk per block.
   const hsize_t dims[1] = {0};
   const hsize_t max_dims[1] = {H5S_UNLIMITED};
@@ -482,39 +512,30 @@ void TraceTable::Impl::write_block(Block& block) {
   for (std::size_t r = 0; r < n; ++r) {
     const double* src = block.rows.data() + r * row_width;
     unsigned char* dst = packed.data() + r * packed_width;
-    for (const Column& c : columns) {
+    for (const CopyRun& run : runs) std::memcpy(dst + run.bytes, src + run.offset, 8 * run.count);
+    for (const Column* column : integers) {
+      const Column& c = *column;
       const double* in = src + c.offset;
       unsigned char* out = dst + c.bytes;
-      const std::size_t w = static_cast<std::size_t>(c.width);
-      switch (c.dtype) {
-        case DType::kFloat64:
-          std::memcpy(out, in, w * sizeof(double));
-          break;
-        case DType::kUInt64:   // the raw bits, see uint64_in_row
-          std::memcpy(out, in, w * sizeof(double));
-          break;
-        default:
-          for (std::size_t k = 0; k < w; ++k) {
-            const double value = in[k];
-            if (!fits(value, c.dtype)) {
-              std::ostringstream message;
-              message.precision(17);
-              message << column_context(c.name) << ": row " << (written + static_cast<std::int64_t>(r))
-                      << " holds " << value << ", which is not an " << name_of(c.dtype);
-              throw TraceError(message.str());
-            }
-            if (c.dtype == DType::kInt64) {
-              const std::int64_t v = static_cast<std::int64_t>(value);
-              std::memcpy(out + 8 * k, &v, 8);
-            } else if (c.dtype == DType::kInt32) {
-              const std::int32_t v = static_cast<std::int32_t>(value);
-              std::memcpy(out + 4 * k, &v, 4);
-            } else {
-              const std::int8_t v = static_cast<std::int8_t>(value);
-              std::memcpy(out + k, &v, 1);
-            }
-          }
-          break;
+      for (std::size_t k = 0; k < static_cast<std::size_t>(c.width); ++k) {
+        const double value = in[k];
+        if (!fits(value, c.dtype)) {
+          std::ostringstream message;
+          message.precision(17);
+          message << column_context(c.name) << ": row " << (written + static_cast<std::int64_t>(r))
+                  << " holds " << value << ", which is not an " << name_of(c.dtype);
+          throw TraceError(message.str());
+        }
+        if (c.dtype == DType::kInt64) {
+          const std::int64_t v = static_cast<std::int64_t>(value);
+          std::memcpy(out + 8 * k, &v, 8);
+        } else if (c.dtype == DType::kInt32) {
+          const std::int32_t v = static_cast<std::int32_t>(value);
+          std::memcpy(out + 4 * k, &v, 4);
+        } else {
+          const std::int8_t v = static_cast<std::int8_t>(value);
+          std::memcpy(out + k, &v, 1);
+        }
       }
     }
   }
@@ -526,6 +547,12 @@ void TraceTable::Impl::write_block(Block& block) {
   const hsize_t start[1] = {static_cast<hsize_t>(written)};
   const hsize_t count[1] = {n};
   if (H5Dset_extent(dataset.get(), new_dims) < 0) fail();
+  if (direct && n == block_rows && static_cast<std::size_t>(written) % block_rows == 0) {
+    // Exactly one whole chunk (the runner's blocks are its chunks): its bytes as they are.
+    if (H5Dwrite_chunk(dataset.get(), H5P_DEFAULT, 0, start, n * packed_width, packed.data()) < 0) fail();
+    written += static_cast<std::int64_t>(n);
+    return;
+  }
   h5::Handle file_space(H5Dget_space(dataset.get()), H5Sclose);
   if (!file_space.valid()) fail();
   if (H5Sselect_hyperslab(file_space.get(), H5S_SELECT_SET, start, nullptr, count, nullptr) < 0) {
