@@ -9,14 +9,17 @@
 #include <fnmatch.h>
 
 #include <algorithm>
+#include <cstring>
 #include <bit>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <limits>
 #include <map>
+#include <optional>
 #include <set>
 #include <type_traits>
+#include <variant>
 
 #include "h5.hpp"
 
@@ -191,11 +194,55 @@ std::vector<std::string> datasets_below(const OpenTrace& t, const std::string& g
 
 enum class Kind { kFloat, kSigned, kUnsigned };
 
+// The rows of one compound table of one file, a block at a time, in the file's row layout
+// converted to native types (no conversion on a little-endian host). All columns of the table
+// decode their members from the same block, so a table is read once however many columns it
+// has; row(r) may move back and forth within a block, forward across blocks.
+struct TableRows {
+  std::string file, path;          // for messages
+  hid_t dataset = H5I_INVALID_HID; // not owned (the columns' handles keep it open)
+  h5::Handle type;                 // native row type
+  std::size_t row_bytes = 0;
+  std::int64_t rows = 0;           // rows to read (the usable length)
+  std::int64_t block = 1;
+  std::int64_t start = 0, count = 0;
+  std::vector<unsigned char> bytes;
+
+  const unsigned char* row(std::int64_t r) {
+    if (r < start || r >= start + count) load(r);
+    return bytes.data() + static_cast<std::size_t>(r - start) * row_bytes;
+  }
+
+  void load(std::int64_t r) {
+    const std::string context = "trace '" + file + "', table '" + path + "'";
+    start = r;
+    count = std::min(block, rows - r);
+    bytes.resize(static_cast<std::size_t>(count) * row_bytes);
+    h5::Handle file_space = h5::checked(H5Dget_space(dataset), H5Sclose, context);
+    const hsize_t offset[1] = {static_cast<hsize_t>(start)};
+    const hsize_t n[1] = {static_cast<hsize_t>(count)};
+    h5::check(H5Sselect_hyperslab(file_space.get(), H5S_SELECT_SET, offset, nullptr, n, nullptr),
+              context);
+    h5::Handle mem_space = h5::checked(H5Screate_simple(1, n, nullptr), H5Sclose, context);
+    h5::check(H5Dread(dataset, type.get(), mem_space.get(), file_space.get(), H5P_DEFAULT,
+                      bytes.data()),
+              context + ": cannot read rows " + std::to_string(start) + " to " +
+                  std::to_string(start + count - 1));
+  }
+};
+
 // One open dataset of an aligned table: its kind, rows and width.
 struct Column {
   std::string file, path;   // path with a leading '/'
   h5::Handle dataset;       // the column's dataset, or its table's (member not empty)
   std::string member;       // the column's member of a compound table, or "" 
+  // A member: where its elements sit in a row of the table's native row type, and how to
+  // decode them (class, size in bytes, signed), read from the rows the table shares.
+  struct TableRows* table_rows = nullptr;
+  std::size_t member_offset = 0;
+  H5T_class_t element_class = H5T_FLOAT;
+  std::size_t element_size = 8;
+  bool element_signed = true;
   Kind kind = Kind::kFloat;
   std::int64_t rows = 0;
   std::size_t width = 1;
@@ -239,6 +286,11 @@ Column open_column(const OpenTrace& t, const std::string& group, const std::stri
     if (index < 0) fail(context + ": no such member");
     h5::Handle member = h5::checked(H5Tget_member_type(row.get(), static_cast<unsigned>(index)),
                                     H5Tclose, context);
+    {
+      // Where the member sits in the native row type the table's rows are read in.
+      h5::Handle native = h5::checked(H5Tget_native_type(row.get(), H5T_DIR_ASCEND), H5Tclose, context);
+      c.member_offset = H5Tget_member_offset(native.get(), static_cast<unsigned>(index));
+    }
     if (H5Tget_class(member.get()) == H5T_ARRAY) {
       if (H5Tget_array_ndims(member.get()) != 1) fail(context + ": not a 1-D array member");
       hsize_t dims[1] = {0};
@@ -270,6 +322,14 @@ Column open_column(const OpenTrace& t, const std::string& group, const std::stri
     c.width = c.rank == 2 ? static_cast<std::size_t>(dims[1]) : 1;
   }
   const H5T_class_t type_class = H5Tget_class(type.get());
+  c.element_class = type_class;
+  c.element_size = H5Tget_size(type.get());
+  c.element_signed = type_class == H5T_INTEGER && H5Tget_sign(type.get()) != H5T_SGN_NONE;
+  if (type_class == H5T_FLOAT && c.element_size != 4 && c.element_size != 8)
+    fail(context + ": floating-point elements of " + std::to_string(c.element_size) + " bytes");
+  if (type_class == H5T_INTEGER && c.element_size != 1 && c.element_size != 2 &&
+      c.element_size != 4 && c.element_size != 8)
+    fail(context + ": integer elements of " + std::to_string(c.element_size) + " bytes");
   if (type_class == H5T_FLOAT) c.kind = Kind::kFloat;
   else if (type_class == H5T_INTEGER)
     c.kind = H5Tget_sign(type.get()) == H5T_SGN_NONE ? Kind::kUnsigned : Kind::kSigned;
@@ -296,11 +356,44 @@ class BlockReader {
       : c_(c), rows_(rows), block_(static_cast<std::int64_t>(std::max<std::size_t>(block, 1))) {}
 
   const T* row(std::int64_t r) {
+    if (c_.table_rows != nullptr) return decode(c_.table_rows->row(r));
     if (r < start_ || r >= start_ + count_) load(r);
     return buffer_.data() + static_cast<std::size_t>(r - start_) * c_.width;
   }
 
  private:
+  // The member's elements of one native row, converted to T (integers exactly; float64 and
+  // uint64 bits as they are).
+  const T* decode(const unsigned char* row) {
+    buffer_.resize(c_.width);
+    const unsigned char* p = row + c_.member_offset;
+    for (std::size_t j = 0; j < c_.width; ++j, p += c_.element_size) {
+      if (c_.element_class == H5T_FLOAT) {
+        if (c_.element_size == 8) { double v; std::memcpy(&v, p, 8); buffer_[j] = static_cast<T>(v); }
+        else { float v; std::memcpy(&v, p, 4); buffer_[j] = static_cast<T>(v); }
+      } else if (c_.element_signed) {
+        std::int64_t v = 0;
+        switch (c_.element_size) {
+          case 1: { std::int8_t x; std::memcpy(&x, p, 1); v = x; break; }
+          case 2: { std::int16_t x; std::memcpy(&x, p, 2); v = x; break; }
+          case 4: { std::int32_t x; std::memcpy(&x, p, 4); v = x; break; }
+          default: std::memcpy(&v, p, 8); break;
+        }
+        buffer_[j] = static_cast<T>(v);
+      } else {
+        std::uint64_t v = 0;
+        switch (c_.element_size) {
+          case 1: { std::uint8_t x; std::memcpy(&x, p, 1); v = x; break; }
+          case 2: { std::uint16_t x; std::memcpy(&x, p, 2); v = x; break; }
+          case 4: { std::uint32_t x; std::memcpy(&x, p, 4); v = x; break; }
+          default: std::memcpy(&v, p, 8); break;
+        }
+        buffer_[j] = static_cast<T>(v);
+      }
+    }
+    return buffer_.data();
+  }
+
   void load(std::int64_t r) {
     const std::string context = "trace " + quoted(c_.file) + ", dataset " + quoted(c_.path);
     start_ = r;
@@ -403,11 +496,11 @@ struct Alignment {
 };
 
 template <typename T>
-void compare_column(const Column& ca, const Column& cb, std::int64_t rows_a, std::int64_t rows_b,
-                    const Alignment& al, const CompareOptions& options, DatasetResult& out) {
-  BlockReader<T> ra(ca, rows_a, options.block_rows), rb(cb, rows_b, options.block_rows);
-  const std::size_t width = ca.width;
-  for (std::size_t k = 0; k < al.tick.size(); ++k) {
+// Compares aligned rows [k0, k1) of one column pair, adding to `out`.
+void compare_range(BlockReader<T>& ra, BlockReader<T>& rb, std::size_t width, std::size_t k0,
+                   std::size_t k1, const Alignment& al, const CompareOptions& options,
+                   DatasetResult& out) {
+  for (std::size_t k = k0; k < k1; ++k) {
     const T* pa = ra.row(al.row_a[k]);
     const T* pb = rb.row(al.row_b[k]);
     for (std::size_t j = 0; j < width; ++j) {
@@ -526,6 +619,32 @@ void compare_loop(const OpenTrace& a, const OpenTrace& b, const std::string& gro
     if (c->kind == Kind::kFloat || c->width != 1)
       fail("trace " + quoted(c->file) + ", dataset " + quoted(c->path) +
            ": a tick column holds one integer per row");
+  // A compound table is read a block of whole rows at a time, shared by its columns, and
+  // compared block by block (every column of a block, then the next block), so each row of
+  // the file is read once. A block is at most 4 MiB of rows.
+  std::optional<TableRows> table_a, table_b;
+  std::int64_t step = static_cast<std::int64_t>(std::max<std::size_t>(options.block_rows, 1));
+  if (!cols_a[tick_i].member.empty() && !cols_b[tick_i].member.empty()) {
+    const auto share = [&](std::optional<TableRows>& t, std::vector<Column>& cols, const OpenTrace& o,
+                           std::int64_t rows) {
+      t.emplace();
+      t->file = o.name;
+      t->path = "/" + group;
+      t->dataset = cols[tick_i].dataset.get();
+      const std::string context = "trace " + quoted(o.name) + ", table " + quoted("/" + group);
+      h5::Handle file_type = h5::checked(H5Dget_type(t->dataset), H5Tclose, context);
+      t->type = h5::checked(H5Tget_native_type(file_type.get(), H5T_DIR_ASCEND), H5Tclose, context);
+      t->row_bytes = H5Tget_size(t->type.get());
+      t->rows = rows;
+      t->block = std::max<std::int64_t>(1, std::min<std::int64_t>(
+                                               step, static_cast<std::int64_t>((4u << 20) / std::max<std::size_t>(t->row_bytes, 1))));
+      for (Column& c : cols) c.table_rows = &*t;
+    };
+    share(table_a, cols_a, a, rows_a);
+    share(table_b, cols_b, b, rows_b);
+    step = std::min(table_a->block, table_b->block);
+  }
+
   const std::vector<std::int64_t> ticks_a = read_all<std::int64_t>(cols_a[tick_i], rows_a, options.block_rows);
   const std::vector<std::int64_t> ticks_b = read_all<std::int64_t>(cols_b[tick_i], rows_b, options.block_rows);
   for (const auto* t : {&ticks_a, &ticks_b})
@@ -561,6 +680,12 @@ void compare_loop(const OpenTrace& a, const OpenTrace& b, const std::string& gro
   loop.matched = static_cast<std::int64_t>(al.tick.size());
   result.loops.push_back(loop);
 
+  using Readers = std::variant<std::pair<BlockReader<double>, BlockReader<double>>,
+                               std::pair<BlockReader<std::int64_t>, BlockReader<std::int64_t>>,
+                               std::pair<BlockReader<std::uint64_t>, BlockReader<std::uint64_t>>>;
+  std::vector<DatasetResult> found;
+  std::vector<Readers> readers;
+  std::vector<std::size_t> widths;
   for (std::size_t k = 0; k < names_a.size(); ++k) {
     if (k == tick_i) continue;   // the key the rows were aligned by
     const Column& ca = cols_a[k];
@@ -584,13 +709,38 @@ void compare_loop(const OpenTrace& a, const OpenTrace& b, const std::string& gro
       }
     }
     if (options.bitwise) d.tolerance = Tolerance{};
+    const std::size_t block = static_cast<std::size_t>(step);
     switch (ca.kind) {
-      case Kind::kFloat: compare_column<double>(ca, cb, rows_a, rows_b, al, options, d); break;
-      case Kind::kSigned: compare_column<std::int64_t>(ca, cb, rows_a, rows_b, al, options, d); break;
-      case Kind::kUnsigned: compare_column<std::uint64_t>(ca, cb, rows_a, rows_b, al, options, d); break;
+      case Kind::kFloat:
+        readers.emplace_back(std::in_place_index<0>, BlockReader<double>(ca, rows_a, block),
+                             BlockReader<double>(cb, rows_b, block));
+        break;
+      case Kind::kSigned:
+        readers.emplace_back(std::in_place_index<1>, BlockReader<std::int64_t>(ca, rows_a, block),
+                             BlockReader<std::int64_t>(cb, rows_b, block));
+        break;
+      case Kind::kUnsigned:
+        readers.emplace_back(std::in_place_index<2>, BlockReader<std::uint64_t>(ca, rows_a, block),
+                             BlockReader<std::uint64_t>(cb, rows_b, block));
+        break;
     }
-    result.datasets.push_back(std::move(d));
+    widths.push_back(ca.width);
+    found.push_back(std::move(d));
   }
+  // A range of aligned rows whose rows lie in one block of each file (a decimated or cut trace
+  // skips rows: its range ends where its rows would leave the block).
+  const std::int64_t block_a = table_a ? table_a->block : step, block_b = table_b ? table_b->block : step;
+  for (std::size_t k0 = 0, k1 = 0; k0 < al.tick.size(); k0 = k1) {
+    k1 = k0 + 1;
+    while (k1 < al.tick.size() && al.row_a[k1] - al.row_a[k0] < block_a &&
+           al.row_b[k1] - al.row_b[k0] < block_b)
+      ++k1;
+    for (std::size_t c = 0; c < found.size(); ++c) {
+      std::visit([&](auto& pair) { compare_range(pair.first, pair.second, widths[c], k0, k1, al, options, found[c]); },
+                 readers[c]);
+    }
+  }
+  for (DatasetResult& d : found) result.datasets.push_back(std::move(d));
 }
 
 CompareResult compare_impl(const std::string& file_a, const std::string& file_b,
