@@ -290,6 +290,8 @@ Model stack_model(int physics, double bottom, double top, double k, double c, do
   const Vec3 hb(0.08, 0.08, 0.02), ht(0.04, 0.04, 0.01);
   m.bodies.push_back(make_box("bottom", bottom, hb, Vec3(0.0, 0.0, hb.z() + gap), Material{0.8, kInfinity, kInfinity}));
   m.bodies.push_back(make_box("top", top, ht, Vec3(0.0, 0.0, 2.0 * hb.z() + ht.z() + 2.0 * gap), Material{0.5, k, c}));
+  // A nudge: a stack started exactly symmetric never excites its rocking modes, stable or not.
+  m.bodies[0].angular_velocity = Vec3(0.01, 0.007, 0.0);
   return m;
 }
 
@@ -330,27 +332,29 @@ bool flags_pair(const Model& m) {
 
 }  // namespace
 
-// Penalty contact at a 100:1 mass ratio. Both boxes start at rest 1 mm above their contacts.
+// Penalty contact at a 100:1 mass ratio. Both boxes start at rest 1 mm above their contacts, the
+// bottom one nudged (0.01 rad/s): a stack started exactly symmetric never excites its rocking
+// modes, stable or not, and would hide an unstable one.
 //  - Depth: each contact point carries at most the whole weight above it, so no corner sinks
-//    deeper than the penalty depth m g / k (m the mass above that contact, k per point): the
-//    static depth is m g / (4 k), a drop of 1 mm onto undamped springs overshoots it by less
-//    than 2x plus the fall. Measured: light on heavy 0.60 (top) and 0.42 (floor) of the bound,
-//    heavy on light 0.63 and 0.62.
+//    deeper than the penalty depth m g / k (m the mass above that contact, k per point). The bound
+//    is checked, not derived for the drop; measured: light on heavy 0.60 (top) and 0.42 (floor) of
+//    it, heavy on light 0.65 and 0.65.
 //  - Energy: no driver, started at rest with relaxed springs, so the bodies' mechanical energy
 //    never exceeds its start (springs only store energy >= 0); checked to 1e-9 J (rounding of a
-//    ~0.3 J potential).
-//  - Jitter: the fastest material point's speed in the last of 4 s is below 1e-5 m/s and below its
-//    largest between 1 and 2 s (no growth). Measured 2e-3 -> 1e-7 m/s light on heavy, 4.7e-3 ->
-//    1.6e-6 m/s heavy on light.
+//    ~0.3 J potential). Weak for the light body: its energy is 1% of the scene's.
+//  - Jitter: the fastest material point's speed (centre speed + |w| x half diagonal) in the last
+//    second is below 1e-4 m/s and below its largest between 1 and 2 s (no growth). Measured
+//    2e-3 -> 1e-7 m/s light on heavy (4 s), 3.4e-2 -> 1.2e-5 m/s heavy on light (6 s).
 // Light on heavy (10 g on 1 kg, k = 40 N/m, c = 0.05 N s/m per point, floor 250 N/m): the light
 // box's rocking h^2 12 k / m_r = 48 / rate^2 x 1e3 is stable from about 110 Hz; tested at 250,
 // 1000 and 3000 Hz, and flagged by stability_warnings() at 50 and 100 Hz.
-// Heavy on light (1 kg on 10 g, k = 2500 N/m per point and per floor vertex, c = 4 N s/m): the
+// Heavy on light (1 kg on 10 g, k = 2500 N/m per point and per floor vertex, c = 2 N s/m): the
 // light box is squeezed between two stiff springs, h^2 12 k / m = 3e6 / rate^2: stable at 3000 Hz
-// only (and then only with h 12 c / m = 1.6 < 2). Measured at 1000 Hz: with c = 4 it explodes
-// (depth 142 m, energy +26 J); with c = 1 it stays bounded but the heavy box's rocking on the
-// light one (damping ratio ~0.01: the damping the light box can take is small) still moves at
-// 1.2 cm/s after 4 s. stability_warnings() flags 250, 500 and 1000 Hz, not 3000 Hz.
+// only. stability_warnings() flags 250, 500 and 1000 Hz (measured at 1000 Hz with c = 4: depth
+// 142 m, energy +26 J), not 3000 Hz. Finding: it does not flag c = 4 at 3000 Hz either, which
+// rocks the light box for ever (0.9 m/s at its corners, a limit cycle): the warning checks each
+// contact alone with 12 c / m_r, while the light box's rocking feels both of its contacts, the
+// floor's and the heavy box's, h C / I = 1.9 with both, 0.94 with each alone.
 TEST_CASE("a 100:1 stack settles without sinking past m g / k or gaining energy", "[hard][stack][law]") {
   const double g = kG;
   SECTION("light on heavy") {
@@ -363,27 +367,35 @@ TEST_CASE("a 100:1 stack settles without sinking past m g / k or gaining energy"
       CHECK(o.top_depth <= 0.01 * g / 40.0);
       CHECK(o.floor_depth <= 1.01 * g / 250.0);
       CHECK(o.energy_gain <= 1e-9);
-      CHECK(o.jitter_late < 1e-5);
+      CHECK(o.jitter_late < 1e-4);
       CHECK(o.jitter_late < o.jitter_early);
       CHECK_FALSE(flags_pair(m));
     }
     for (int rate : {50, 100}) CHECK(flags_pair(stack_model(rate, 1.0, 0.01, 40.0, 0.05, 250.0, 2.5, 0.001)));
   }
   SECTION("heavy on light") {
-    const Model m = stack_model(3000, 0.01, 1.0, 2500.0, 4.0, 2500.0, 4.0, 0.001);
-    const StackOutcome o = stack_drop(m, 4.0);
+    const Model m = stack_model(3000, 0.01, 1.0, 2500.0, 2.0, 2500.0, 2.0, 0.001);
+    const StackOutcome o = stack_drop(m, 6.0);
     INFO("top " << o.top_depth << " m, floor " << o.floor_depth << " m, gain " << o.energy_gain
                 << " J, jitter " << o.jitter_early << " -> " << o.jitter_late << " m/s");
     CHECK(o.finite);
     CHECK(o.top_depth <= 1.0 * g / 2500.0);
     CHECK(o.floor_depth <= 1.01 * g / 2500.0);
     CHECK(o.energy_gain <= 1e-9);
-    CHECK(o.jitter_late < 1e-5);
+    CHECK(o.jitter_late < 1e-4);
     CHECK(o.jitter_late < o.jitter_early);
     CHECK_FALSE(flags_pair(m));
     for (int rate : {250, 500, 1000}) {
-      CHECK(flags_pair(stack_model(rate, 0.01, 1.0, 2500.0, 4.0, 2500.0, 4.0, 0.001)));
+      CHECK(flags_pair(stack_model(rate, 0.01, 1.0, 2500.0, 2.0, 2500.0, 2.0, 0.001)));
     }
+  }
+  SECTION("heavy on light, damped beyond the light box's rocking: a lasting cycle, not flagged") {
+    const Model m = stack_model(3000, 0.01, 1.0, 2500.0, 4.0, 2500.0, 4.0, 0.001);
+    const StackOutcome o = stack_drop(m, 4.0);
+    INFO("jitter " << o.jitter_early << " -> " << o.jitter_late << " m/s");
+    CHECK(o.finite);
+    CHECK(o.jitter_late > 0.1);
+    CHECK_FALSE(flags_pair(m));   // the finding: the estimate misses the sandwiched body
   }
 }
 
@@ -707,3 +719,4 @@ TEST_CASE("a rod gripped below m g / (2 mu k) slides out of the grip", "[hard][g
     CHECK_FALSE(o.held);
   }
 }
+
