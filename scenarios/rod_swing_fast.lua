@@ -8,7 +8,7 @@
 -- 19 m/s^2, 1.9 g), then holds still. At the paper's 50 Hz the grip's mode (m_eff = 0.13 kg at the
 -- grip on 2 k = 600 N/m) has h^2 2 k / m_eff = 1.9, inside the bound 4 - 2 h C / m_eff = 3.4; twice
 -- the stiffness would not be. Checked: no slip-out, no NaN (the run stops on a diverged body), the
--- grip holds (each finger's god-object slips less than 0.5 mm over the swing: 0.46 mm at 50 Hz,
+-- grip holds (each finger's god-object slips less than 0.5 mm over the swing: 0.23 mm at 50 Hz,
 -- where the cone is reached at the fastest turn, 0 at 500 Hz and faster;
 -- tests/engine/test_hard_cases.cpp), and the swing energy, once the hand stops, does not grow
 -- beyond symplectic Euler's wobble h w0 (13% at 50 Hz) plus 1 mJ.
