@@ -238,7 +238,9 @@ void decimate_trace(const std::string& in, const std::string& out, const Decimat
   Id src(H5Fopen(in.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), H5Fclose, "cannot open " + where);
   const std::int64_t rate_servo = read_int_attribute(src.get(), "rate_servo", where);
   const std::int64_t rate_physics = read_int_attribute(src.get(), "rate_physics", where);
-  const std::int64_t stride = options.stride > 0 ? options.stride : std::max<std::int64_t>(1, rate_servo / rate_physics);
+  const std::int64_t stride =
+      options.stride > 0 ? options.stride
+                         : std::max<std::int64_t>(1, rate_servo / std::min(rate_physics, kGoldenRowsPerSecond));
 
   const std::string temporary = out + ".part";
   {
@@ -251,8 +253,8 @@ void decimate_trace(const std::string& in, const std::string& out, const Decimat
            "cannot create '" + temporary + "'");
     copy_attributes(src.get(), dst.get(), where);
     write_string_attribute(dst.get(), "golden",
-                           format("golden format 1 (HDF5 1.10 file format), decimated: every /physics row; /servo and /haptic rows at ticks that are "
-                                  "multiples of %" PRId64 " (servo ticks); shuffle + deflate %d",
+                           format("golden format 1 (HDF5 1.10 file format), decimated: the /servo, /haptic and /physics rows at ticks that are "
+                                  "multiples of %" PRId64 " (servo ticks; every physics tick up to 500 per simulated s); shuffle + deflate %d",
                                   stride, options.compression),
                            "'" + temporary + "'");
     write_string_attribute(dst.get(), "golden_cpu", cpu_model(), "'" + temporary + "'");
@@ -262,7 +264,7 @@ void decimate_trace(const std::string& in, const std::string& out, const Decimat
       const std::string context = "cannot copy " + path + " of " + where;
       Id object(H5Oopen(src.get(), name.c_str(), H5P_DEFAULT), H5Oclose, context);
       std::vector<hsize_t> rows;
-      const bool loop = name == "servo" || name == "haptic";
+      const bool loop = name == "servo" || name == "haptic" || name == "physics";
       if (H5Iget_type(object.get()) == H5I_DATASET) {
         // Schema 3: the loop is one compound dataset; its rows are decimated by its tick member.
         std::vector<std::int64_t> ticks;
