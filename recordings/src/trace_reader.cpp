@@ -91,14 +91,17 @@ Location locate(hid_t file, const std::string& path, const std::string& context)
       // The rest names a member of this table, or a prefix of member names.
       std::string rest = path.substr(next);
       while (!rest.empty() && rest.back() == '/') rest.pop_back();
+      // An exact member wins; otherwise a prefix of members is a "group" of them.
+      bool exact = false, below = false;
       for (const std::string& m : member_names(object.get(), context)) {
-        if (m == rest || m.rfind(rest + "/", 0) == 0) {
-          out.object = std::move(object);
-          out.table = prefix;
-          out.member = rest;
-          out.member_prefix = m != rest;
-          if (!out.member_prefix) return out;
-        }
+        exact = exact || m == rest;
+        below = below || m.rfind(rest + "/", 0) == 0;
+      }
+      if (exact || below) {
+        out.object = std::move(object);
+        out.table = prefix;
+        out.member = rest;
+        out.member_prefix = !exact;
       }
       return out;   // a prefix of members, or nothing (object invalid)
     }

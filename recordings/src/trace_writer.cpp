@@ -107,6 +107,10 @@ bool fits(double value, DType dtype) {
 
 std::string quoted(const std::string& text) { return "'" + text + "'"; }
 
+// The largest compound row type a table may have: HDF5 stores a dataset's datatype in one object
+// header message of at most 64 KiB (65535 bytes), kept clear of by 1.5 KB.
+constexpr std::size_t kMaxRowTypeBytes = 64000;   // bytes
+
 struct Column {
   std::string name;      // member name, relative to the table: "fingers/thumb/hip"
   int width;             // values per row
@@ -164,8 +168,8 @@ class TraceWriterWorker {
   void start(bool thread, std::size_t capacity, Run run) {
     run_ = std::move(run);
     ring_.assign(capacity + 1, Job{});
+    if (thread) worker_ = std::thread([this] { loop(); });   // may throw: then no thread
     threaded_ = thread;
-    if (threaded_) worker_ = std::thread([this] { loop(); });
   }
 
   // Hands a job over (runs it at once without a thread). Rethrows a failure of an earlier job.
@@ -333,6 +337,12 @@ std::size_t TraceTable::add_column(const std::string& path, int width, DType dty
   if (width < 1) throw TraceError(t.column_context(path) + ": width must be at least 1");
   for (const Column& c : t.columns) {
     if (c.name == path) throw TraceError(t.column_context(path) + ": column declared twice");
+    // Column paths form a tree, as datasets in groups did (schema 2): "a" and "a/b" cannot both
+    // be columns, or "/t/a" would name both a column and a group of columns.
+    if (c.name.rfind(path + "/", 0) == 0 || path.rfind(c.name + "/", 0) == 0) {
+      throw TraceError(t.column_context(path) + ": column path clashes with column " +
+                       quoted(c.name) + " (one would be a group of the other)");
+    }
   }
   const std::size_t offset = t.row_width;
   t.columns.push_back(Column{path, width, dtype, offset, t.packed_width});
@@ -596,9 +606,31 @@ struct TraceWriter::Impl {
 // it costs a few milliseconds), and from here on only the worker touches the file.
 void TraceWriter::Impl::freeze() {
   std::size_t blocks = 0;
-  for (auto& [name, table] : tables) {
-    if (table->impl_->columns.empty()) {
-      throw TraceError(context() + ": cannot create table " + quoted("/" + name) + ": it has no columns");
+  {
+    // Checked here, before the writer thread exists, so a table HDF5 cannot store fails at the
+    // first row, not at close: a compound type is stored in one object header message, at most
+    // 64 KiB (about 90 objects of /physics with short names).
+    h5::Lock lock;
+    h5::Quiet quiet;
+    for (auto& [name, table] : tables) {
+      TraceTable::Impl& t = *table->impl_;
+      const std::string where = context() + ": cannot create table " + quoted("/" + name);
+      if (t.columns.empty()) throw TraceError(where + ": it has no columns");
+      // The datatype message's size in the newest format (version 3 compound and array
+      // types, as the file uses): an 8-byte type header, and per member its name with a NUL,
+      // a 4-byte offset (at most), an array header of 8 + 1 + 4 bytes if width > 1, and the
+      // element type, 20 bytes for a float, 12 for an integer. (H5Tencode would give the
+      // oldest format's size, which pads names: 40% more.)
+      std::size_t encoded = 8;
+      for (const Column& c : t.columns) {
+        encoded += c.name.size() + 1 + 4 + (c.width > 1 ? 13 : 0) + (c.dtype == DType::kFloat64 ? 20 : 12);
+      }
+      if (encoded > kMaxRowTypeBytes) {
+        throw TraceError(where + ": its " + std::to_string(t.columns.size()) + " columns need a " +
+                         std::to_string(encoded) + "-byte HDF5 row type, more than the " +
+                         std::to_string(kMaxRowTypeBytes) +
+                         " an object header holds (fewer objects or fingers, or shorter names)");
+      }
     }
   }
   for (auto& [name, table] : tables) {
@@ -656,6 +688,17 @@ TraceWriter::TraceWriter(const std::string& path, TraceOptions options)
   }
   h5::Lock lock;
   h5::Quiet quiet;
+  // On failure the handles made so far are closed here, under the lock (not after it, as the
+  // members' destructors would).
+  struct Release {
+    Impl* impl;
+    ~Release() {
+      if (impl != nullptr) {
+        impl->root.reset();
+        impl->file.reset();
+      }
+    }
+  } release{impl_.get()};
   h5::Handle fapl = file_access(options.swmr, where);
   impl_->file = h5::checked(H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, fapl.get()),
                             H5Fclose, where);
@@ -666,6 +709,7 @@ TraceWriter::TraceWriter(const std::string& path, TraceOptions options)
   impl_->root = h5::checked(H5Gopen2(impl_->file.get(), "/", H5P_DEFAULT), H5Gclose, where);
   h5::write_string_attribute(impl_->root.get(), "status", "running", where);
   h5::check(H5Fflush(impl_->file.get(), H5F_SCOPE_LOCAL), where);
+  release.impl = nullptr;
 }
 
 TraceWriter::~TraceWriter() {
@@ -804,6 +848,9 @@ void TraceWriter::close(const std::string& status) {
   try {
     const std::string where = w.context() + ": cannot reopen to write the status";
     h5::Handle fapl = file_access(w.options.swmr, where);
+    // A SWMR reader (h5py following the run) holds the file's lock: without this the reopen
+    // fails and the status stays "running". The reader sees the final attributes on reopening.
+    h5::check(H5Pset_file_locking(fapl.get(), 0, 1), where);
     h5::Handle file = h5::checked(H5Fopen(w.path.c_str(), H5F_ACC_RDWR, fapl.get()), H5Fclose, where);
     h5::Handle root = h5::checked(H5Gopen2(file.get(), "/", H5P_DEFAULT), H5Gclose, where);
     for (const auto& [name, write] : w.pending) {

@@ -18,6 +18,7 @@
 #include "app/run.hpp"
 #include "graspsim/recordings/trace_reader.hpp"
 #include "graspsim/recordings/trace_recorder.hpp"
+#include "graspsim/recordings/trace_writer.hpp"
 #include "graspsim/scripting/scenario.hpp"
 #include "tests/support/shell.hpp"
 
@@ -197,4 +198,57 @@ TEST_CASE("a run killed with SIGKILL halfway leaves a readable, repairable trace
   // Nothing left to repair; a file that is not a trace is bad input.
   CHECK(shell(kCli + " repair " + file).status == 0);
   CHECK(shell(kCli + " repair " + kScenario).status == 2);
+}
+
+// A reader following a run (h5py in SWMR mode, as recordings/README.md suggests) holds the
+// file's lock while the run ends: the writer still finishes the file (status "complete" and the
+// kept attributes), since close() reopens it without file locking. The follower is a python
+// process that opens the trace, says so, and holds it until its stdin closes.
+TEST_CASE("a run ends cleanly while an h5py SWMR reader holds its trace", "[e2e][crash]") {
+  if (shell(std::string(kPython) + " -c 'import h5py'").status != 0) {
+    WARN("python3-h5py is not installed (" << kPython << "): skipped");
+    return;
+  }
+  const std::string file = kTmp + "/e2e_followed.h5";
+  std::remove(file.c_str());
+  recordings::TraceOptions options;
+  options.background = true;
+  recordings::TraceWriter writer(file, options);
+  recordings::TraceTable& t = writer.table("servo");
+  t.add_column("tick", 1, recordings::DType::kInt64, "tick");
+  for (int r = 0; r < 100; ++r) *t.append_row() = r;
+  writer.flush();
+  writer.wait();
+  int to_child[2], from_child[2];
+  REQUIRE(pipe(to_child) == 0);
+  REQUIRE(pipe(from_child) == 0);
+  const pid_t child = fork();
+  REQUIRE(child >= 0);
+  if (child == 0) {
+    dup2(to_child[0], 0);
+    dup2(from_child[1], 1);
+    close(to_child[1]);
+    close(from_child[0]);
+    execl(kPython, kPython, "-c",
+          "import sys, h5py\n"
+          "f = h5py.File(sys.argv[1], 'r', swmr=True)\n"
+          "print(f['servo'].shape[0], flush=True)\n"
+          "sys.stdin.read()\n",
+          file.c_str(), static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  close(to_child[0]);
+  close(from_child[1]);
+  char line[64] = {};
+  const ssize_t got = read(from_child[0], line, sizeof line - 1);   // the reader has it open
+  CHECK(got > 0);
+  CHECK(std::atoi(line) == 100);
+  writer.set_attribute("expectations", "PASS kept for close()");
+  CHECK_NOTHROW(writer.close("complete"));
+  close(to_child[1]);   // the reader may go
+  int status = 0;
+  waitpid(child, &status, 0);
+  close(from_child[0]);
+  CHECK(recordings::read_string_attribute(file, "/", "status") == "complete");
+  CHECK(recordings::read_string_attribute(file, "/", "expectations") == "PASS kept for close()");
 }

@@ -683,3 +683,53 @@ TEST_CASE("reading a trace while a writer thread writes another is safe",
   CHECK(exact == 20);
   CHECK(read_dataset(file, "/t/x").values.at(399) == 399.0);
 }
+
+// Column paths form a tree (as datasets in groups did): "a" and "a/b" cannot both be columns of
+// a table, in either order, since "/t/a" would then name a column and a group of columns.
+TEST_CASE("a column cannot be a prefix of another", "[trace_writer][errors]") {
+  const std::string file = tmp_path("prefix_columns.h5");
+  TraceWriter writer(file);
+  TraceTable& t = writer.table("t");
+  t.add_column("a/b", 1, DType::kFloat64, "m");
+  CHECK_THROWS_WITH(t.add_column("a", 1, DType::kFloat64, "m"), Catch::Contains("clashes with column 'a/b'"));
+  t.add_column("c", 1, DType::kFloat64, "m");
+  CHECK_THROWS_AS(t.add_column("c/d", 1, DType::kFloat64, "m"), TraceError);
+  t.add_column("ab", 1, DType::kFloat64, "m");   // a prefix of the name, not of the path: fine
+  double* row = t.append_row();
+  row[0] = 1.0, row[1] = 2.0, row[2] = 3.0;
+  writer.close("complete");
+  CHECK(read_dataset(file, "/t/a/b").values == std::vector<double>{1.0});
+  CHECK(read_dataset(file, "/t/ab").values == std::vector<double>{3.0});
+  CHECK(has_object(file, "/t/a"));   // a group of columns
+  CHECK_THROWS_AS(read_dataset(file, "/t/a"), TraceError);
+}
+
+// HDF5 keeps a dataset's datatype in one object header message (64 KiB at most): a table with
+// too many columns for one compound row is refused at the first row, with the reason, before
+// any simulation time is spent, not at close (where the writer thread would find it).
+// 12 columns of width 3 per object, named as the recorder names them: 40 objects fit, 400 do not.
+// (HDF5 itself takes up to 86 of them: the estimate is conservative by about 5%.)
+TEST_CASE("a table too wide for one HDF5 row type fails at the first row", "[trace_writer][errors]") {
+  for (const int objects : {40, 400}) {
+    const std::string file = tmp_path("wide.h5");
+    TraceOptions options;
+    options.background = true;
+    TraceWriter writer(file, options);
+    TraceTable& t = writer.table("physics");
+    for (int k = 0; k < objects; ++k) {
+      const std::string p = "objects/object_" + std::to_string(k) + "/";
+      for (const char* q : {"position", "quaternion", "velocity", "angular_velocity", "force", "torque",
+                            "floor_contacts", "body_contacts", "grasp_area", "torsion", "twist", "extra"}) {
+        t.add_column(p + q, 3, DType::kFloat64, "1");
+      }
+    }
+    INFO(objects << " objects");
+    if (objects == 40) {
+      CHECK_NOTHROW(t.append_row());
+      CHECK_NOTHROW(writer.close("complete"));
+    } else {
+      CHECK_THROWS_WITH(t.append_row(), Catch::Contains("object header"));
+      CHECK_THROWS_AS(writer.close("complete"), TraceError);
+    }
+  }
+}
