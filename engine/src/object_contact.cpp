@@ -63,8 +63,23 @@ int floor_contact(const Model& model, int body, BodyState& bs, Wrench& out) {
   const double floor_z = model.floor.height;
   int touching = 0;
   const int count = static_cast<int>(bs.floor_contacts.size());
+  // Meshes and hulls (thousands of vertices, most far above the floor): each vertex's height is
+  // screened first with one row of R, and one clearly above the floor (by 1e-12 m per metre of
+  // the numbers involved, far more than the few ulps by which the full product can differ) is
+  // what the full test would make it, inactive. The points that may touch take the full path.
+  const std::vector<Vec3>* vertices = nullptr;
+  if (bp.shape.kind == ShapeKind::kMesh && bp.shape.mesh) vertices = &bp.shape.mesh->vertices;
+  if (bp.shape.kind == ShapeKind::kConvex) {
+    vertices = bp.shape.hull ? &bp.shape.hull->vertices : (bp.shape.mesh ? &bp.shape.mesh->vertices : nullptr);
+  }
+  const Vec3 row_z = bs.rotation.row(2).transpose();
+  const double clear = 1e-12 * (1.0 + std::abs(bs.position.z()) + std::abs(floor_z));   // m
   for (int k = 0; k < count; ++k) {
     VertexContact& vc = bs.floor_contacts[k];
+    if (vertices && bs.position.z() + row_z.dot((*vertices)[k]) > floor_z + clear) {
+      vc.active = false;
+      continue;
+    }
     bool rolling = false;
     const Vec3 r = floor_point(bp.shape, bs.rotation, k, rolling);   // m: from centre of mass
     const Vec3 x = bs.position + r;
