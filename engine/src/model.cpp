@@ -157,6 +157,13 @@ void validate(const Model& model) {
   if (r.servo % r.physics != 0)
     fail("rates.physics", std::to_string(r.physics) + " Hz does not divide rates.servo = " + std::to_string(r.servo) + " Hz");
   if (!finite(model.gravity)) fail("gravity", "must be finite");
+  const SleepParams& sl = model.sleep;
+  if (!(sl.linear_speed >= 0.0) || std::isinf(sl.linear_speed))
+    fail("sleep.linear_speed", "must be >= 0 m/s and finite (got " + str(sl.linear_speed) + ")");
+  if (!(sl.angular_speed >= 0.0) || std::isinf(sl.angular_speed))
+    fail("sleep.angular_speed", "must be >= 0 rad/s and finite (got " + str(sl.angular_speed) + ")");
+  if (!(sl.time > 0.0) || !(sl.time <= 1e6))
+    fail("sleep.time", "must be > 0 s and at most 1e6 s (got " + str(sl.time) + ")");
   const GraspParams& g = model.grasp;
   if (!(g.critical_area >= 0.0) || std::isinf(g.critical_area))
     fail("grasp.critical_area", "must be >= 0 m^2 and finite (got " + str(g.critical_area) + ")");

@@ -63,8 +63,23 @@ int floor_contact(const Model& model, int body, BodyState& bs, Wrench& out) {
   const double floor_z = model.floor.height;
   int touching = 0;
   const int count = static_cast<int>(bs.floor_contacts.size());
+  // Meshes and hulls (thousands of vertices, most far above the floor): each vertex's height is
+  // screened first with one row of R, and one clearly above the floor (by 1e-12 m per metre of
+  // the numbers involved, far more than the few ulps by which the full product can differ) is
+  // what the full test would make it, inactive. The points that may touch take the full path.
+  const std::vector<Vec3>* vertices = nullptr;
+  if (bp.shape.kind == ShapeKind::kMesh && bp.shape.mesh) vertices = &bp.shape.mesh->vertices;
+  if (bp.shape.kind == ShapeKind::kConvex) {
+    vertices = bp.shape.hull ? &bp.shape.hull->vertices : (bp.shape.mesh ? &bp.shape.mesh->vertices : nullptr);
+  }
+  const Vec3 row_z = bs.rotation.row(2).transpose();
+  const double clear = 1e-12 * (1.0 + std::abs(bs.position.z()) + std::abs(floor_z));   // m
   for (int k = 0; k < count; ++k) {
     VertexContact& vc = bs.floor_contacts[k];
+    if (vertices && bs.position.z() + row_z.dot((*vertices)[k]) > floor_z + clear) {
+      vc.active = false;
+      continue;
+    }
     bool rolling = false;
     const Vec3 r = floor_point(bp.shape, bs.rotation, k, rolling);   // m: from centre of mass
     const Vec3 x = bs.position + r;
@@ -114,6 +129,17 @@ namespace {
 
 std::uint64_t combine(std::uint64_t h, std::uint64_t v) {
   return h ^ (v + 0x9e3779b97f4a7c15ULL + (h << 6) + (h >> 2));
+}
+
+// Wakes both bodies of pair index pi among n bodies (pair_index's inverse, by walking rows).
+void wake_pair(State& state, int pi, int n) {
+  int a = 0;
+  while (pi >= n - a - 1) {
+    pi -= n - a - 1;
+    ++a;
+  }
+  wake(state.bodies[a]);
+  wake(state.bodies[a + 1 + pi]);
 }
 
 bool polyhedral(const Shape& s) { return s.kind == ShapeKind::kBox || (s.kind == ShapeKind::kConvex && s.hull); }
@@ -402,13 +428,38 @@ void BodyContacts::step(const Model& model, State& state, std::vector<Wrench>& w
   // The tree's order depends on how it was built: sort, so that results never do.
   std::sort(im.candidates.begin(), im.candidates.end());
 
+  // Sleep: a sleeping body whose box a moving body's box overlaps wakes first (a body landing on
+  // it, pushing it). Moving: an awake body over a sleep threshold; a body just woken is at rest,
+  // so one pass decides.
+  if (model.sleep.enabled) {
+    const auto moving = [&](const BodyState& s) {
+      return !s.asleep && (s.velocity.norm() > model.sleep.linear_speed ||
+                           s.angular_velocity.norm() > model.sleep.angular_speed);
+    };
+    for (const auto& [a, b] : im.candidates) {
+      BodyState& sa = state.bodies[a];
+      BodyState& sb = state.bodies[b];
+      if (sa.asleep && moving(sb)) wake(sa);
+      if (sb.asleep && moving(sa)) wake(sb);
+    }
+  }
+
   for (const auto& [a, b] : im.candidates) {
     const ContactPair cp = contact_pair(model.bodies[a].material, model.bodies[b].material);
     if (!collides(cp)) continue;
     const std::size_t pi = pair_index(a, b, nb);
     im.touched[pi] = 1;
     PairContact& pc = state.pairs[pi];
+    if (state.bodies[a].asleep && state.bodies[b].asleep) {   // both at rest: the contact stands
+      points[a] += pc.count;
+      points[b] += pc.count;
+      continue;
+    }
     const int n = im.find(state, a, b);
+    if (n == 0 && pc.count > 0) {   // a support gone: a sleeper on it wakes, stepped from now
+      wake(state.bodies[a]);
+      wake(state.bodies[b]);
+    }
     BodyState& sa = state.bodies[a];
     BodyState& sb = state.bodies[b];
     for (int i = 0; i < n; ++i) {
@@ -458,8 +509,12 @@ void BodyContacts::step(const Model& model, State& state, std::vector<Wrench>& w
     pc.count = n;
   }
   // Pairs no longer near each other lose their anchors.
+  // A sleeper among them wakes: its support moved away.
   for (std::size_t pi = 0; pi < im.touched.size(); ++pi) {
-    if (!im.touched[pi]) state.pairs[pi].count = 0;
+    if (!im.touched[pi] && state.pairs[pi].count > 0) {
+      state.pairs[pi].count = 0;
+      if (model.sleep.enabled) wake_pair(state, static_cast<int>(pi), nb);
+    }
     im.touched[pi] = 0;
   }
 }

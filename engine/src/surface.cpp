@@ -384,6 +384,63 @@ bool walk(const SurfaceGeometry& g, double r, bool glued, const Vec3& h, Vec3& p
   return S.count > 0;
 }
 
+// Face f's entry test for the path a -> b: the plane (grown by r) crossed from outside, at the
+// crossing inside the polygon grown in-plane by r + kTol. Keeps the earliest crossing, ties to
+// the lower face index (the order a linear scan over the faces gives).
+void try_crossing(const SurfaceGeometry& g, double r, int f, const Vec3& a, const Vec3& b, double& best,
+                  int& face) {
+  const double sa = plane_gap(g, r, f, a), sb = plane_gap(g, r, f, b);
+  if (sa < -kTol || !(sb < 0.0)) return;   // a on the plane (to rounding) counts as outside
+  const double t = std::max(sa, 0.0) / (sa - sb);
+  if (t > best || (t == best && f > face)) return;
+  if (!in_polygon(g, r, f, a + t * (b - a), r + kTol)) return;
+  best = t;
+  face = f;
+}
+
+// Whether the segment a -> b meets the box [lo - e, hi + e] (slabs, closed).
+bool segment_meets_box(const Vec3& a, const Vec3& d, const Vec3& lo, const Vec3& hi, double e) {
+  double t0 = 0.0, t1 = 1.0;
+  for (int j = 0; j < 3; ++j) {
+    const double l = lo[j] - e, h = hi[j] + e;
+    if (d[j] == 0.0) {
+      if (a[j] < l || a[j] > h) return false;
+      continue;
+    }
+    double u = (l - a[j]) / d[j], v = (h - a[j]) / d[j];
+    if (u > v) std::swap(u, v);
+    t0 = std::max(t0, u);
+    t1 = std::min(t1, v);
+    if (t0 > t1) return false;
+  }
+  return true;
+}
+
+// The first face crossed by a -> b (try_crossing over every face), found through the face tree:
+// only faces in leaves whose grown boxes the segment meets are tried. The boxes hold each face's
+// whole entry region (see SurfaceGeometry::BvhNode) with 1e-9 m to spare for rounding, and the
+// tie rule does not depend on the visiting order, so the result is the linear scan's, bit for
+// bit. A fixed stack: no allocation.
+void first_crossing(const SurfaceGeometry& g, double r, const Vec3& a, const Vec3& b, double& best, int& face) {
+  const auto& nodes = g.bvh();
+  if (nodes.empty()) return;
+  const Vec3 d = b - a;
+  std::array<int, 64> stack{};
+  int top = 0;
+  stack[top++] = 0;
+  while (top > 0) {
+    const SurfaceGeometry::BvhNode& node = nodes[stack[--top]];
+    const double grow = node.kappa * (r + kTol) + r + 1e-9;   // m
+    if (!segment_meets_box(a, d, node.lo, node.hi, grow)) continue;
+    if (node.count > 0) {
+      for (int i = 0; i < node.count; ++i) try_crossing(g, r, g.bvh_face(node.first + i), a, b, best, face);
+      continue;
+    }
+    stack[top++] = node.right;
+    stack[top++] = node.first;
+  }
+}
+
 // Face plane of a box as a SurfaceTrack, if the HIP is below it and over the face (the existing
 // box rule, kept exactly: faces offset by r, edges square; off a face's edge the contact ends).
 bool track_box(const Shape& s, double r, int face, const Vec3& x, SurfaceTrack& out) {
@@ -465,6 +522,58 @@ SurfaceGeometry::SurfaceGeometry(const Shape& shape) : shape_(shape) {
     ring_.insert(ring_.end(), ring.begin(), ring.end());
     faces_.push_back(F);
   }
+  // The face tree (first_crossing): faces with a plane, their centroids, a 1 / sin(angle / 2)
+  // per face from its sharpest corner.
+  std::vector<Vec3> centroids(faces_.size(), Vec3::Zero());
+  for (int f = 0; f < static_cast<int>(faces_.size()); ++f) {
+    const PolyFace& F = faces_[f];
+    if (!std::isfinite(F.offset)) continue;
+    for (int i = 0; i < F.count; ++i) centroids[f] += corners_[F.first + i] / F.count;
+    bvh_faces_.push_back(f);
+  }
+  if (!bvh_faces_.empty()) {
+    bvh_.reserve(2 * bvh_faces_.size());
+    build_bvh(0, static_cast<int>(bvh_faces_.size()), centroids);
+  }
+}
+
+int SurfaceGeometry::build_bvh(int first, int count, const std::vector<Vec3>& centroids) {
+  constexpr int kLeafFaces = 4;
+  const int index = static_cast<int>(bvh_.size());
+  bvh_.push_back(BvhNode{Vec3::Constant(kInfinity), Vec3::Constant(-kInfinity), 1.0, first, count, -1});
+  Vec3 clo = Vec3::Constant(kInfinity), chi = Vec3::Constant(-kInfinity);
+  for (int i = first; i < first + count; ++i) {
+    const PolyFace& F = faces_[bvh_faces_[i]];
+    BvhNode& node = bvh_[index];
+    for (int k = 0; k < F.count; ++k) {
+      const Vec3& c = corners_[F.first + k];
+      node.lo = node.lo.cwiseMin(c);
+      node.hi = node.hi.cwiseMax(c);
+      const Vec3 u = corners_[F.first + (k + F.count - 1) % F.count] - c;
+      const Vec3 v = corners_[F.first + (k + 1) % F.count] - c;
+      const double cos_angle = u.dot(v) / (u.norm() * v.norm());
+      const double sin_half = std::sqrt(std::max(0.0, 0.5 * (1.0 - cos_angle)));
+      node.kappa = std::max(node.kappa, sin_half > 0.0 ? 1.0 / sin_half : kInfinity);
+    }
+    clo = clo.cwiseMin(centroids[bvh_faces_[i]]);
+    chi = chi.cwiseMax(centroids[bvh_faces_[i]]);
+  }
+  if (count <= kLeafFaces) return index;
+  int axis = 0;
+  (chi - clo).maxCoeff(&axis);
+  const int half = count / 2;
+  // Median by centroid along the axis, ties by face index: a total order, so the tree does not
+  // depend on the sort's implementation.
+  std::sort(bvh_faces_.begin() + first, bvh_faces_.begin() + first + count, [&](int p, int q) {
+    const double cp = centroids[p][axis], cq = centroids[q][axis];
+    return cp < cq || (cp == cq && p < q);
+  });
+  bvh_[index].count = 0;
+  const int left = build_bvh(first, half, centroids);
+  const int right = build_bvh(first + half, count - half, centroids);
+  bvh_[index].first = left;
+  bvh_[index].right = right;
+  return index;
 }
 
 std::optional<SurfaceEntry> surface_entry(const SurfaceGeometry& g, double r, const Vec3& a,
@@ -503,7 +612,7 @@ std::optional<SurfaceEntry> surface_entry(const SurfaceGeometry& g, double r, co
     }
     case ShapeKind::kConvex:
     case ShapeKind::kMesh: {
-      // Linear scan: the first face plane (grown by r) crossed from outside inside its polygon
+      // The first face plane (grown by r) crossed from outside inside its polygon
       // (for a pad grown in-plane by r, covering the offset faces' gaps at convex edges; the
       // point is then moved onto the polygon). A path starting inside a convex polyhedron (the
       // body moved onto the finger, or the first tick) takes the face nearest to b, as a box
@@ -525,15 +634,7 @@ std::optional<SurfaceEntry> surface_entry(const SurfaceGeometry& g, double r, co
         }
       }
       const bool from_inside = face >= 0;
-      for (int f = 0; f < g.face_count() && !from_inside; ++f) {
-        const double sa = plane_gap(g, r, f, a), sb = plane_gap(g, r, f, b);
-        if (sa < -kTol || !(sb < 0.0)) continue;   // a on the plane (to rounding) counts as outside
-        const double t = std::max(sa, 0.0) / (sa - sb);
-        if (t >= best) continue;
-        if (!in_polygon(g, r, f, a + t * (b - a), r + kTol)) continue;
-        best = t;
-        face = f;
-      }
+      if (!from_inside) first_crossing(g, r, a, b, best, face);
       if (face < 0) return std::nullopt;
       const auto& F = g.face(face);
       Vec3 q = (from_inside ? b : Vec3(a + best * (b - a))) - r * F.normal;

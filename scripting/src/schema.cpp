@@ -250,6 +250,24 @@ FloorParams read_floor(const LuaValue* value) {
   return floor;
 }
 
+// sleep = true | false | { linear_speed = m/s, angular_speed = rad/s, time = s } (a table: on).
+SleepParams read_sleep(const LuaValue* value) {
+  SleepParams sleep;
+  if (value == nullptr) return sleep;
+  const Where where{"", "sleep"};
+  if (value->type == LuaValue::Type::kBoolean) {
+    sleep.enabled = value->boolean;
+    return sleep;
+  }
+  if (!value->is_table()) fail(where, "expected a table, true or false, got " + value->type_name());
+  const Record r(*value, where, TableKind::kSleep);
+  sleep.enabled = true;
+  sleep.linear_speed = r.number_or("linear_speed", sleep.linear_speed);
+  sleep.angular_speed = r.number_or("angular_speed", sleep.angular_speed);
+  sleep.time = r.number_or("time", sleep.time);
+  return sleep;
+}
+
 BodyParams object(const LuaValue& value, std::size_t index, const std::string& base_dir) {
   const Where where{element_label("objects", index, value, "name"), ""};
   const Record r(value, where, TableKind::kObject);
@@ -460,11 +478,12 @@ bool is_named_array(TableKind kind) {
 const std::vector<std::string>& fields_of(TableKind kind) {
   static const std::vector<std::string> kRoot = {
       "name", "description", "duration", "seed", "rates", "gravity", "gyroscopic",
-      "grasp", "floor", "objects", "fingers", "expect"};
+      "grasp", "floor", "sleep", "objects", "fingers", "expect"};
   static const std::vector<std::string> kGrasp = {"torsion", "critical_area", "gimbal_finger", "dead_band",
                                                       "torsional_damping"};
   static const std::vector<std::string> kRates = {"servo", "haptic", "physics"};
   static const std::vector<std::string> kFloor = {"height", "material"};
+  static const std::vector<std::string> kSleep = {"linear_speed", "angular_speed", "time"};
   static const std::vector<std::string> kMaterial = {"mu", "mu_kinetic", "stiffness", "damping", "viscous"};
   static const std::vector<std::string> kObject = {
       "name", "shape", "size", "radius", "length", "file", "scale", "mass", "density", "inertia",
@@ -478,6 +497,7 @@ const std::vector<std::string>& fields_of(TableKind kind) {
     case TableKind::kRoot: return kRoot;
     case TableKind::kRates: return kRates;
     case TableKind::kFloor: return kFloor;
+    case TableKind::kSleep: return kSleep;
     case TableKind::kMaterial: return kMaterial;
     case TableKind::kGrasp: return kGrasp;
     case TableKind::kObject: return kObject;
@@ -495,6 +515,7 @@ TableKind child_kind(TableKind parent, const LuaKey& key) {
       if (key.is_index) return TableKind::kValue;
       if (name == "rates") return TableKind::kRates;
       if (name == "floor") return TableKind::kFloor;
+      if (name == "sleep") return TableKind::kSleep;
       if (name == "grasp") return TableKind::kGrasp;
       if (name == "gravity") return TableKind::kVector;
       if (name == "objects") return TableKind::kObjects;
@@ -582,6 +603,7 @@ ScenarioParts convert_scenario(const LuaValue& root, const std::string& default_
                        : name == "implicit" ? Gyroscopic::kImplicit : Gyroscopic::kNeglect;
   }
   s.model.floor = read_floor(r.get("floor"));
+  s.model.sleep = read_sleep(r.get("sleep"));
 
   if (const LuaValue* objects = r.get("objects")) {
     const auto elements = array(*objects, r.at("objects"), "an array of objects { {name = ...}, ... }");

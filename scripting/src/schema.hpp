@@ -17,7 +17,7 @@ namespace graspsim::scripting::detail {
 // The kinds of tables in a scenario. Records have named fields; arrays are indexed 1..n; the
 // elements of objects, fingers and expect are also addressed by their name (or `what`).
 enum class TableKind {
-  kRoot, kRates, kFloor, kMaterial, kGrasp,
+  kRoot, kRates, kFloor, kMaterial, kGrasp, kSleep,
   kObjects, kObject, kFingers, kFinger, kWaypoints, kWaypoint, kExpects, kExpectation,
   kVector,   // {x, y, z} or {w, x, y, z}
   kValue,    // not a table of the format (a number, a string, a function...)

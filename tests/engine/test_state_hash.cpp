@@ -49,6 +49,7 @@ State sample_state() {
     b.window_force = vec();
     b.window_torque = vec();
   }
+  s.bodies[1].still_steps = 3;
   s.fingers.resize(2);
   for (FingerState& f : s.fingers) {
     f.hip_at_last_servo = vec();
@@ -117,6 +118,9 @@ std::vector<Mutation> mutations() {
     add(p + "floor_contacts (one more)", [b](State& s) { s.bodies[b].floor_contacts.emplace_back(); });
     add_vec(p + "window_force", [b](State& s) -> Vec3& { return s.bodies[b].window_force; });
     add_vec(p + "window_torque", [b](State& s) -> Vec3& { return s.bodies[b].window_torque; });
+    // Body 0 has sleep at its defaults (hashed only when set), body 1 is counting towards sleep.
+    add(p + "asleep", [b](State& s) { s.bodies[b].asleep ^= true; });
+    add(p + "still_steps", [b](State& s) { ++s.bodies[b].still_steps; });
   }
   add("bodies (one more)", [](State& s) { s.bodies.emplace_back(); });
   for (int f = 0; f < 2; ++f) {
@@ -176,9 +180,9 @@ TEST_CASE("changing any one field of the state changes its hash", "[state_hash]"
   const State base = sample_state();
   const std::uint64_t h0 = state_hash(base);
   const auto all = mutations();
-  // tick, 2 bodies x 54 scalars (+ a floor point), the body count, 2 fingers x 27, the finger
+  // tick, 2 bodies x 56 scalars (54 + asleep, still_steps) (+ a floor point), the body count, 2 fingers x 27, the finger
   // count, pair count, 16 points x 8, the pair count: every field is visited.
-  REQUIRE(all.size() == 1 + 2 * 54 + 1 + 2 * 27 + 1 + 1 + 16 * 8 + 1);
+  REQUIRE(all.size() == 1 + 2 * 56 + 1 + 2 * 27 + 1 + 1 + 16 * 8 + 1);
   std::vector<std::uint64_t> seen{h0};
   for (const auto& [name, mutate] : all) {
     State s = base;

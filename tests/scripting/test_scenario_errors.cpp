@@ -179,3 +179,20 @@ TEST_CASE("bad gyroscopic, grasp and friction values are named with their field"
   CHECK_THAT(message({"objects.box.material.viscous=-1"}), Catch::Contains("viscous"));
   CHECK_THAT(message({"fingers.thumb.radius=-0.01"}), Catch::Contains("radius"));
 }
+
+// Bad sleep values name their field.
+TEST_CASE("bad sleep values are named with their field", "[scenario][errors]") {
+  const auto message = [](std::vector<std::string> sets) {
+    graspsim::scripting::LoadOptions options;
+    options.sets = std::move(sets);
+    try {
+      graspsim::scripting::Scenario::load(scripting_test::data_path("valid.lua"), options);
+    } catch (const graspsim::scripting::ScenarioError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  CHECK_THAT(message({"sleep.time=0"}), Catch::Contains("sleep.time") && Catch::Contains("> 0 s"));
+  CHECK_THAT(message({"sleep.linear_speed=-1"}), Catch::Contains("sleep.linear_speed"));
+  CHECK_THAT(message({"sleep=3"}), Catch::Contains("sleep") && Catch::Contains("expected a table, true or false"));
+}

@@ -158,3 +158,21 @@ TEST_CASE("gyroscopic, grasp and kinetic friction fields convert to the model", 
   CHECK(m.fingers[1].radius == 0.0);
   CHECK(graspsim::kinetic_mu(m.bodies[1].material) == m.bodies[1].material.mu);   // unset: = mu
 }
+
+// sleep: absent is off; true takes the defaults; a table (here made by --set of its fields) turns
+// it on with its fields.
+TEST_CASE("the sleep field converts to the model", "[scenario][load]") {
+  const auto load = [](std::vector<std::string> sets) {
+    graspsim::scripting::LoadOptions options;
+    options.sets = std::move(sets);
+    return graspsim::scripting::Scenario::load(scripting_test::data_path("valid.lua"), options).model().sleep;
+  };
+  CHECK_FALSE(load({}).enabled);
+  const graspsim::SleepParams on = load({"sleep=true"});
+  CHECK(on.enabled);
+  CHECK(on.time == graspsim::SleepParams{}.time);
+  const graspsim::SleepParams set = load({"sleep.time=0.25", "sleep.linear_speed=0.002"});
+  CHECK(set.enabled);
+  CHECK(set.time == 0.25);
+  CHECK(set.linear_speed == 0.002);
+}

@@ -112,8 +112,19 @@ struct GraspParams {
                                     //      engine/README.md); 0: the inertial swing w_u += dt T_u / J
 };
 
+// Sleeping (engine/README.md, "Sleep"): a body whose speeds stay under both thresholds for
+// `time` (counted in physics ticks: ceil(time x physics rate)) stops being stepped, its pose
+// frozen and its velocities zero, until a finger touches it or a moving body reaches it.
+struct SleepParams {
+  bool enabled = false;          // off by default: on changes the traces of resting bodies
+  double linear_speed = 1e-3;    // m/s: |v| at or under this counts as still
+  double angular_speed = 1e-2;   // rad/s: |w| at or under this counts as still
+  double time = 0.5;             // s: how long a body stays still before it sleeps
+};
+
 struct Model {
   Rates rates;
+  SleepParams sleep;
   Gyroscopic gyroscopic = Gyroscopic::kNeglect;
   GraspParams grasp;
   Vec3 gravity{0.0, 0.0, -9.81};   // m/s^2

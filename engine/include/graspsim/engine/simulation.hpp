@@ -43,10 +43,13 @@ class Simulation {
   Divisors divisors_;
   State state_;
   CollisionWorld collision_;
+  bool collision_stale_ = false;   // bodies moved since collision_ was last updated
   std::vector<int> scratch_;   // candidate bodies of a finger query
   BodyContacts body_contacts_;            // body-body contact (its own broadphase)
   std::vector<Wrench> contact_wrench_;    // per body: body-body contact wrench of this step
   std::vector<int> contact_points_;       // per body: body-body contact points of this step
+  std::vector<double> floor_reach_;       // m, per body: farthest floor point from the centre of mass
+  std::vector<std::uint8_t> floor_clear_;  // per body: 1 when none of its floor points is active
 };
 
 }  // namespace graspsim

@@ -86,6 +86,8 @@ struct BodyState {
   Vec3 position_before_step{0.0, 0.0, 0.0};       // m, world
   Mat3 rotation_before_step = Mat3::Identity();   // 1: body to world
   std::int64_t stepped_at = -1;                   // servo tick of the last physics step (-1: none)
+  bool asleep = false;       // sleeping: not stepped, pose frozen, velocities zero (Model::sleep)
+  int still_steps = 0;       // 1: physics steps in a row with |v| and |w| under the sleep thresholds
   std::vector<VertexContact> floor_contacts;   // one per floor point of the shape (object_contact.hpp),
                                                // sized by initial_state
   // Finger wrench accumulated over the current physics window (sum over servo ticks).
@@ -99,6 +101,12 @@ struct State {
   std::vector<FingerState> fingers;   // same order as Model::fingers
   std::vector<PairContact> pairs;     // every body pair a < b, at pair_index(a, b, bodies)
 };
+
+// Wakes a sleeping body (no-op when awake): it is stepped again from rest, counting anew.
+inline void wake(BodyState& body) {
+  body.asleep = false;
+  body.still_steps = 0;
+}
 
 // The state at t = 0 given by the model's initial conditions.
 State initial_state(const Model& model);

@@ -57,6 +57,22 @@ class SurfaceGeometry {
   int neighbour(int i) const { return neighbours_[i]; }   // face across edge i (corner i -> i+1), -1 open
   int ring(int i) const { return ring_[i]; }
 
+  // A bounding-volume tree over the faces (kConvex, kMesh): axis-aligned boxes of the faces'
+  // corners, split at the median centroid along the longest axis, a few faces per leaf. A face's
+  // entry region for a pad of radius r (its polygon grown in-plane by r + slack, offset by r) lies
+  // within its box grown by kappa (r + slack) + r, kappa = max over its corners of
+  // 1 / sin(angle / 2) (an offset polygon's corner moves that far); `kappa` is the largest in the
+  // node. Degenerate faces (no plane) are left out: no path crosses them.
+  struct BvhNode {
+    Vec3 lo, hi;     // m, body frame: box of the corners below the node
+    double kappa;    // 1: the largest corner factor below the node
+    int first;       // leaf: first index into bvh_faces(); inner: index of the left child
+    int count;       // leaf: faces; inner: 0 (the right child follows the left's subtree)
+    int right;       // inner: index of the right child
+  };
+  const std::vector<BvhNode>& bvh() const { return bvh_; }
+  int bvh_face(int i) const { return bvh_faces_[i]; }
+
  private:
   Shape shape_;
   std::vector<PolyFace> faces_;
@@ -64,6 +80,9 @@ class SurfaceGeometry {
   std::vector<Vec3> edge_normals_;
   std::vector<int> neighbours_;
   std::vector<int> ring_;
+  std::vector<BvhNode> bvh_;
+  std::vector<int> bvh_faces_;
+  int build_bvh(int first, int count, const std::vector<Vec3>& centroids);
 };
 
 struct SurfaceEntry {
