@@ -1,4 +1,5 @@
-// state_hash: FNV-1a 64 over the State's fields, one 64-bit word at a time, in declaration order.
+// state_hash: an FNV-1a-style hash over the State's fields, one 64-bit word per step (xor,
+// multiply by the FNV-1a 64 prime, xor-shift by 32), in declaration order.
 #include "graspsim/engine/state_hash.hpp"
 
 #include <bit>
@@ -20,11 +21,15 @@ static_assert(sizeof(PairPointContact) == 64, "PairPointContact changed: update 
 
 class Hasher {
  public:
+  // One 64-bit word per step (8 times fewer multiplies than feeding its bytes, which made the
+  // hash the largest logging cost at 3 kHz physics): FNV-1a's xor and multiply on the whole
+  // word, then an xor-shift. The multiply only carries a bit upward, so without the shift a
+  // difference in a word's top bit (a sign) would stay in the top bit, and two of them (x and
+  // y both negated) would cancel; the shift folds the top half down before the next word.
   void word(std::uint64_t w) {
-    for (int i = 0; i < 8; ++i) {   // little-endian, whatever the host
-      hash_ ^= (w >> (8 * i)) & 0xffu;
-      hash_ *= kFnv1a64Prime;
-    }
+    hash_ ^= w;
+    hash_ *= kFnv1a64Prime;
+    hash_ ^= hash_ >> 32;
   }
   void real(double x) { word(std::bit_cast<std::uint64_t>(x)); }
   void integer(std::int64_t i) { word(static_cast<std::uint64_t>(i)); }

@@ -52,7 +52,7 @@ TraceRecorder::TraceRecorder(TraceWriter& writer, const graspsim::Model& model,
   physics_time_ = time_columns(physics_);
   state_hash_ = physics_.add_column("state_hash", 1, DType::kUInt64, "1");
   physics_.set_attribute("state_hash", "hash",
-                         "FNV-1a 64 of the engine State after this tick's step "
+                         "FNV-1a-style word hash of the engine State after this tick's step "
                          "(graspsim::state_hash, engine/README.md)");
 
   for (const auto& finger : model.fingers) {

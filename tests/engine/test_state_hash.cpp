@@ -218,3 +218,29 @@ TEST_CASE("swapping two bodies or two fingers changes the hash (order is part of
   std::swap(s.fingers[0], s.fingers[1]);
   CHECK(state_hash(s) != state_hash(base));
 }
+
+// The hash's word step folds high bits down: negating two different doubles (two differences
+// in a word's top bit only) changes the hash, as does negating one. With FNV-1a's xor and
+// multiply alone on whole words, a top-bit difference never leaves the top bit and the two
+// cancel (h' = h + 2^63 twice): this test fails without the xor-shift.
+TEST_CASE("sign flips of two values do not cancel in the state hash", "[state_hash]") {
+  State s;
+  s.bodies.resize(1);
+  s.bodies[0].position = Vec3(0.25, -1.5, 3.0);
+  s.bodies[0].velocity = Vec3(0.5, 2.0, -0.125);
+  const std::uint64_t h = state_hash(s);
+  int cancelled = 0;
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) {
+      State t = s;
+      t.bodies[0].position[i] = -t.bodies[0].position[i];
+      t.bodies[0].velocity[j] = -t.bodies[0].velocity[j];
+      cancelled += state_hash(t) == h;
+      State u = s;
+      u.bodies[0].position[i] = -u.bodies[0].position[i];
+      u.bodies[0].position[(i + 1) % 3] = -u.bodies[0].position[(i + 1) % 3];
+      cancelled += state_hash(u) == h;
+    }
+  }
+  CHECK(cancelled == 0);
+}
