@@ -174,6 +174,14 @@ class TraceWriterWorker {
 
   // Hands a job over (runs it at once without a thread). Rethrows a failure of an earlier job.
   void submit(const Job& job) {
+    // A flush right after a flush (no block between them) adds nothing: dropped here, by the
+    // order of submission alone, so the file's HDF5 calls never depend on the writer's timing.
+    const bool flush = job.block == nullptr && !job.create;
+    if (flush && last_was_flush_) {
+      if (!threaded_) rethrow();
+      return;
+    }
+    last_was_flush_ = flush;
     if (!threaded_) {
       rethrow();
       try {
@@ -186,11 +194,6 @@ class TraceWriterWorker {
     }
     std::unique_lock lock(mutex_);
     if (error_) std::rethrow_exception(error_);
-    // A flush right after a flush still waiting adds nothing.
-    const Job& last = ring_[(head_ + size_ + ring_.size() - 1) % ring_.size()];
-    if (job.block == nullptr && !job.create && size_ > 0 && last.block == nullptr && !last.create) {
-      return;
-    }
     ring_[(head_ + size_) % ring_.size()] = job;
     ++size_;
     wake_.notify_one();
@@ -260,6 +263,7 @@ class TraceWriterWorker {
   std::vector<Job> ring_;
   std::size_t head_ = 0, size_ = 0;
   bool threaded_ = false, busy_ = false, stopping_ = false;
+  bool last_was_flush_ = false;   // the last job submitted was a flush (submitting thread only)
   std::exception_ptr error_;
   std::mutex mutex_;
   std::condition_variable wake_, idle_, returned_;
@@ -700,7 +704,11 @@ TraceWriter::TraceWriter(const std::string& path, TraceOptions options)
     }
   } release{impl_.get()};
   h5::Handle fapl = file_access(options.swmr, where);
-  impl_->file = h5::checked(H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, fapl.get()),
+  // The root group too is created without time stamps (the file creation list is an object
+  // creation list): with them, two runs' files differed in the root's header whenever they
+  // started in different seconds.
+  h5::Handle fcpl = untimed(H5P_FILE_CREATE, where);
+  impl_->file = h5::checked(H5Fcreate(path.c_str(), H5F_ACC_TRUNC, fcpl.get(), fapl.get()),
                             H5Fclose, where);
   impl_->state.file = impl_->file.get();
   impl_->state.context = impl_->context();
