@@ -1,5 +1,4 @@
 // The Lua sandbox: what scenario code can and cannot reach, and how runaway code is stopped.
-#include <chrono>
 #include <cstdio>
 #include <memory>
 #include <string>
@@ -31,10 +30,6 @@ std::string run_one(LuaSandbox& lua, const std::string& code) {
   const std::vector<std::string> results = lua.run(code, "test.lua");
   REQUIRE(results.size() == 1);
   return results[0];
-}
-
-double seconds_since(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
 }  // namespace
@@ -78,12 +73,13 @@ TEST_CASE("print writes one '[lua] ' line per call to stderr", "[lua_sandbox]") 
 
 // The count hook fires every 1000 instructions and raises once the budget is spent; after that
 // it fires on every instruction, so even a loop that catches the error with pcall stops.
-TEST_CASE("an endless loop stops with the instruction-budget message, quickly", "[lua_sandbox]") {
+// The budget is counted in Lua instructions, not time: that it stops at all (with the budget's
+// message, not at ctest's timeout) is the law; how fast is the machine's business.
+TEST_CASE("an endless loop stops with the instruction-budget message", "[lua_sandbox]") {
   SandboxLimits limits;
   limits.load_instructions = 5'000'000;
   const auto sandbox = locked_sandbox(limits);
   LuaSandbox& lua = *sandbox;
-  const auto start = std::chrono::steady_clock::now();
   CHECK_THAT(error_of([&] { lua.run("local n = 0\nwhile true do n = n + 1 end", "loop.lua"); }),
              StartsWith("loop.lua:2: instruction budget of 5000000 instructions exceeded "
                         "(an endless loop?)"));
@@ -97,14 +93,12 @@ TEST_CASE("an endless loop stops with the instruction-budget message, quickly", 
   CHECK(run_one(lua, "local n = 0 for i = 1, 1000000 do n = n + i end return n") == "500000500000");
   CHECK_THAT(error_of([&] { lua.run("while true do end", "call.lua", Budget::kCall); }),
              Contains("instruction budget of 20000000 instructions exceeded"));
-  CHECK(seconds_since(start) < 2.0);
 }
 
 TEST_CASE("a memory bomb stops with the memory-limit message and the state stays usable",
           "[lua_sandbox]") {
   const auto sandbox = locked_sandbox();   // the default limit, 256 MiB
   LuaSandbox& lua = *sandbox;
-  const auto start = std::chrono::steady_clock::now();
   CHECK(error_of([&] {
           lua.run("local s = string.rep('x', 1 << 20) while true do s = s .. s end", "bomb.lua");
         }) == "memory limit of 256 MiB exceeded");
@@ -121,7 +115,6 @@ TEST_CASE("a memory bomb stops with the memory-limit message and the state stays
                         "t = nil\nerror(e)", "tables.lua");
              }),
              StartsWith("tables.lua:4: memory limit of 8 MiB exceeded"));
-  CHECK(seconds_since(start) < 2.0);
 }
 
 // Lua 5.4 seeds math.random from the clock and an address unless told otherwise.

@@ -1,6 +1,5 @@
 // What a loaded scenario does during a run: finger trajectories (waypoints or Lua functions of
 // time) and expectations (Lua checks of a snapshot).
-#include <chrono>
 #include <cmath>
 #include <string>
 
@@ -105,11 +104,9 @@ TEST_CASE("an endless loop in a trajectory function stops with the per-call budg
   options.limits.call_instructions = 1'000'000;
   const Scenario s = Scenario::load(data_path("functions.lua"), options);
   auto stuck = s.make_trajectory(5);
-  const auto start = std::chrono::steady_clock::now();
   CHECK_THAT(error_of([&] { stuck->position(0.0); }),
              Contains("instruction budget of 1000000 instructions exceeded (an endless loop?) "
                       "(fingers[6] 'stuck' trajectory at t = 0 s)"));
-  CHECK(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() < 1.0);
 }
 
 TEST_CASE("an expectation passes or fails with its message, and sees now and initial",
