@@ -8,7 +8,8 @@
 // threads: the cost on one core); the overhead of logging as a share of each (1 - off/on); and
 // the trace size per simulated second.
 // Not a test (tests never time things): run it by hand on an idle machine,
-//   ./build/tools/bench_trace_overhead [REPEATS] [SCENARIO] [DURATION_S]
+//   ./build/tools/bench_trace_overhead [REPEATS] [SCENARIO] [DURATION_S] [NAME=VALUE...]
+// (the NAME=VALUE arguments are --set overrides, e.g. rates.physics=3000 rates.haptic=3000)
 #include <time.h>
 
 #include <algorithm>
@@ -50,6 +51,7 @@ int main(int argc, char** argv) {
   const std::string path = argc > 2 ? argv[2] : std::string(GRASPSIM_SOURCE_DIR) + "/scenarios/two_finger_lift.lua";
   scripting::LoadOptions load;
   if (argc > 3) load.sets.push_back(std::string("duration=") + argv[3]);
+  for (int i = 4; i < argc; ++i) load.sets.push_back(argv[i]);
   std::optional<scripting::Scenario> loaded;
   try {
     loaded.emplace(scripting::Scenario::load(path, load));
