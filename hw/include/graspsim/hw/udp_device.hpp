@@ -1,0 +1,125 @@
+// UdpDevice: a finger driven by a device server over UDP (hw/README.md, "UDP protocol"). The
+// link logic (sequence numbers, hold, timeout, counters) is UdpLink, which sees only bytes and
+// graspsim's time, so it is tested without sockets; UdpDevice adds a non-blocking POSIX socket.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+
+#include "graspsim/hw/device.hpp"
+#include "graspsim/hw/udp_protocol.hpp"
+
+namespace graspsim::hw {
+
+struct UdpDeviceConfig {
+  std::string host = "127.0.0.1";   // the device server: a numeric address or a host name
+  std::uint16_t port = 0;            // the device server's UDP port
+  std::uint16_t local_port = 0;      // our UDP port; 0 = any free port
+  double timeout_s = 0.05;           // s, graspsim time: no new sample for longer -> link lost, force 0
+  DeviceLimits limits{};             // the clamp every rendered force goes through
+  // Lockstep (tests, `device_server --lockstep`): the server answers every datagram we send with
+  // exactly one datagram, and read() first waits for the answers to all we sent, so the run
+  // does not depend on timing. Off for a real device: read() never waits.
+  bool lockstep = false;
+  double answer_wait_s = 10.0;   // s, wall clock, lockstep only: an unanswered datagram is an error
+  double handshake_s = 2.0;      // s, wall clock: make_udp_device waits this long for the first
+                                 //   sample (not in lockstep; 0 = do not wait)
+};
+
+// Counts since the device was made. DEVCLI records them in the trace.
+struct UdpCounters {
+  std::uint64_t received = 0;    // samples accepted (newer than every sample before)
+  std::uint64_t lost = 0;        // sample sequence numbers skipped between accepted samples
+  std::uint64_t late = 0;        // valid samples not newer than the newest (late or duplicate): dropped
+  std::uint64_t malformed = 0;   // datagrams refused by the decoder (any reason): dropped
+  std::uint64_t held = 0;        // reads with no new sample: the last sample was returned again
+  std::uint64_t link_lost = 0;   // times the link went from alive to lost (timeout)
+};
+
+// The receiving side of the link, without a socket: feed it datagrams, then ask for the sample
+// of a read at graspsim time `time`. No heap allocation.
+class UdpLink {
+ public:
+  explicit UdpLink(double timeout_s);
+  // One received datagram (any bytes): a valid newer sample replaces the newest; anything else
+  // is counted (late or malformed) and dropped.
+  void accept(const std::uint8_t* data, std::size_t size);
+  void count_malformed() { ++counters_.malformed; }   // a datagram too large to even read
+  // The sample for a read at `time` (s): the newest sample; counts a hold when no new sample
+  // came since the previous read, and declares the link lost when the last new sample was seen
+  // at a read more than timeout_s before `time` (or none ever came). A new sample revives it.
+  DeviceSample read(double time);
+  bool link_lost() const { return lost_; }
+  bool has_sample() const { return has_sample_; }
+  const udp::Sample& newest() const { return newest_; }   // valid once has_sample()
+  const UdpCounters& counters() const { return counters_; }
+  double timeout_s() const { return timeout_s_; }
+
+ private:
+  double timeout_s_;             // s, graspsim time
+  udp::Sample newest_{};         // the newest valid sample
+  bool has_sample_ = false;
+  bool fresh_ = false;           // a new sample came since the previous read
+  bool lost_ = true;             // link lost: no sample yet, or timed out
+  double last_fresh_time_ = 0;   // s, graspsim time of the read that last brought a new sample
+  UdpCounters counters_{};
+};
+
+class UdpDevice final : public Device {
+ public:
+  // Opens a non-blocking UDP socket bound to config.local_port, connected to host:port (so only
+  // the server's datagrams are received), and sends a hello. Throws std::runtime_error naming
+  // the host, port or local port when it cannot.
+  explicit UdpDevice(const UdpDeviceConfig& config);
+  ~UdpDevice() override;
+  UdpDevice(const UdpDevice&) = delete;
+  UdpDevice& operator=(const UdpDevice&) = delete;
+
+  // Drains the socket (non-blocking; in lockstep after waiting for the answers owed) and returns
+  // the newest sample, in the server's frame and SI units. `tick` is not used.
+  DeviceSample read(std::int64_t tick, double time) override;
+  DeviceLimits limits() const override { return config_.limits; }
+  std::string describe() const override;   // "udp 127.0.0.1:7001"
+
+  // Waits (wall clock, at most max_wait_s) for the first sample, resending the hello every
+  // 0.25 s; true once one came. Start-up only: never called from read().
+  bool wait_for_first_sample(double max_wait_s);
+
+  const UdpCounters& counters() const { return link_.counters(); }
+  bool link_lost() const { return link_.link_lost(); }
+  const udp::Sample& newest() const { return link_.newest(); }   // with its sequence and device time
+  bool has_sample() const { return link_.has_sample(); }
+  const Vec3& last_force() const { return last_force_; }   // N: the force last sent (0 while lost)
+  std::uint32_t datagrams_sent() const { return sent_; }   // hellos and forces
+  std::uint16_t local_port() const { return local_port_; } // the port actually bound
+  const UdpDeviceConfig& config() const { return config_; }
+
+ protected:
+  // Sends a force datagram answering the newest sample: zero while the link is lost.
+  void output(const Vec3& force) override;
+
+ private:
+  void send_hello();
+  void send(const std::uint8_t* data, std::size_t size);
+  void drain();
+  bool wait_readable(double max_wait_s);
+
+  UdpDeviceConfig config_;
+  UdpLink link_;
+  int fd_ = -1;
+  std::uint16_t local_port_ = 0;
+  std::uint32_t sent_ = 0;             // datagrams sent: the next one's sequence number
+  std::uint64_t answers_ = 0;          // datagrams received (any), for lockstep's accounting
+  Vec3 last_force_{0.0, 0.0, 0.0};     // N
+};
+
+// The backend's factory: a UdpDevice, and (unless lockstep or handshake_s = 0) its first sample
+// waited for; throws std::runtime_error "udp device HOST:PORT: no sample within S s ..." if none.
+std::unique_ptr<Device> make_udp_device(const UdpDeviceConfig& config);
+
+// Parses "HOST:PORT[,timeout=S][,local_port=N][,lockstep]" (a leading "udp:" is allowed) into a
+// config with default limits. Throws std::invalid_argument naming the spec and what is wrong.
+UdpDeviceConfig parse_udp_spec(const std::string& spec);
+
+}  // namespace graspsim::hw

@@ -1,0 +1,224 @@
+// The UDP device bridge end to end: the real tools/device_server on loopback, in --lockstep (one
+// sample per datagram, no clock), driving a UdpDevice as the run loop does (read, then render,
+// every servo tick). Samples in, forces out and sequence numbers are checked on both sides;
+// a run where the server loses samples holds, counts, and zeroes the force after the timeout.
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <string>
+#include <sys/wait.h>
+#include <vector>
+
+#include "graspsim/hw/udp_device.hpp"
+#include "graspsim/recordings/trace_reader.hpp"
+#include "tests/support/shell.hpp"
+
+using namespace graspsim::hw;
+
+namespace {
+
+// A device_server child process: the first line it prints gives its port; the rest is read
+// when it exits. It exits by itself after --samples; --idle-exit guards against a hung test.
+class Server {
+ public:
+  explicit Server(const std::string& options) {
+    const std::string command = std::string(GRASPSIM_DEVICE_SERVER) + " --port 0 --lockstep --idle-exit 60 " + options;
+    pipe_ = popen(command.c_str(), "r");
+    REQUIRE(pipe_ != nullptr);
+    char line[512];
+    REQUIRE(std::fgets(line, sizeof line, pipe_) != nullptr);
+    first_line_ = line;
+    const std::size_t at = first_line_.find("127.0.0.1:");
+    REQUIRE(at != std::string::npos);
+    port_ = static_cast<std::uint16_t>(std::stoi(first_line_.substr(at + 10)));
+  }
+  ~Server() {
+    if (pipe_ != nullptr) pclose(pipe_);
+  }
+  std::uint16_t port() const { return port_; }
+  const std::string& first_line() const { return first_line_; }
+  // Everything printed after the first line, once the server has exited; and its status.
+  std::string finish(int* status) {
+    std::string out;
+    char buf[4096];
+    while (std::size_t n = std::fread(buf, 1, sizeof buf, pipe_)) out.append(buf, n);
+    const int raw = pclose(pipe_);
+    pipe_ = nullptr;
+    *status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
+    return out;
+  }
+
+ private:
+  FILE* pipe_ = nullptr;
+  std::uint16_t port_ = 0;
+  std::string first_line_;
+};
+
+struct PrintedForce {
+  unsigned sequence, answers;
+  Vec3 force;
+};
+
+std::vector<PrintedForce> printed_forces(const std::string& out) {
+  std::vector<PrintedForce> forces;
+  std::size_t at = 0;
+  while ((at = out.find("force seq=", at)) != std::string::npos) {
+    PrintedForce f{};
+    REQUIRE(std::sscanf(out.c_str() + at, "force seq=%u answers=%u F=%lf,%lf,%lf", &f.sequence, &f.answers,
+                        &f.force[0], &f.force[1], &f.force[2]) == 5);
+    forces.push_back(f);
+    ++at;
+  }
+  return forces;
+}
+
+UdpDeviceConfig config_for(const Server& server, double max_force) {
+  UdpDeviceConfig c = parse_udp_spec("127.0.0.1:" + std::to_string(server.port()) + ",timeout=0.05,lockstep");
+  c.limits = DeviceLimits{max_force};
+  return c;
+}
+
+}  // namespace
+
+TEST_CASE("UDP bridge: device_server's line motion in, forces out, sequence numbers on both sides",
+          "[e2e][udp]") {
+  // The server's line: p(t) = from + (to - from) min(t / 0.1 s, 1) at t = k / 1000 Hz for sample
+  // k. Within 1e-15 m (a few ulp of 0.1 m; an off-by-one sample is 0.3 mm off in x).
+  const int n_samples = 300;
+  Server server("--rate 1000 --motion line --from 0,0,0.1 --to 0.03,0.06,0.1 --duration 0.1 --samples " +
+                std::to_string(n_samples) + " --print-every 1");
+  UdpDevice d(config_for(server, 5.0));
+  std::vector<Vec3> rendered;
+  for (int n = 0; n < n_samples; ++n) {
+    const DeviceSample s = d.read(n, n / 3000.0);
+    const double u = std::min((n / 1000.0) / 0.1, 1.0);
+    const Vec3 expected(0.03 * u, 0.06 * u, 0.1);
+    INFO("tick " << n);
+    CHECK((s.position - expected).cwiseAbs().maxCoeff() <= 1e-15);
+    CHECK(s.gimbal == Vec3::Zero());
+    CHECK(d.newest().sequence == static_cast<std::uint32_t>(n));
+    CHECK(d.newest().device_time == n / 1000.0);
+    rendered.push_back(d.render(n % 100 == 99 ? Vec3(0.0, 40.0, -30.0) : Vec3(1e-3 * n, -2e-3 * n, 0.5)));
+  }
+  int status = -1;
+  const std::string out = server.finish(&status);
+  CHECK(status == 0);
+  const std::vector<PrintedForce> forces = printed_forces(out);
+  REQUIRE(forces.size() == static_cast<std::size_t>(n_samples));
+  for (int n = 0; n < n_samples; ++n) {
+    INFO("force " << n);
+    CHECK(forces[n].sequence == static_cast<unsigned>(n + 1));   // datagram 0 was the hello
+    CHECK(forces[n].answers == static_cast<unsigned>(n));
+    CHECK(forces[n].force == rendered[n]);   // %.17g: exact round trip
+    CHECK(forces[n].force.norm() <= 5.0);
+  }
+  CHECK(out.find("300 samples (0 lost, 300 datagrams sent), 300 forces, 1 hellos, 0 malformed") != std::string::npos);
+  const UdpCounters& c = d.counters();
+  CHECK(c.received == 300);
+  CHECK(c.lost + c.late + c.held + c.malformed + c.link_lost == 0);
+}
+
+TEST_CASE("UDP bridge: samples the server loses are held and counted, and the force is zero after "
+          "the timeout", "[e2e][udp][timeout]") {
+  // device_server --drop-every 10 --stop-after 200 loses samples 9, 19, ..., 199 (20) and all
+  // after 200; in lockstep it answers in their place with a repeat of the last sample sent.
+  // So of 400 answers, 181 are new samples (0..200 less 20), 219 are repeats (late, and a hold
+  // each), and 20 sequence numbers are skipped. The last new sample is read at tick 200; at
+  // 3000 Hz with a 0.05 s timeout the link is lost at the first tick n with
+  // n / 3000 - 200 / 3000 > 0.05 (351: at 350 the difference rounds to exactly 0.05), and every
+  // force from that tick's render on is zero.
+  const int n_samples = 400;
+  Server server("--rate 3000 --motion circle --center 0,0,0.1 --radius 0.02 --period 0.5 --drop-every 10 "
+                "--stop-after 200 --samples 400 --print-every 1");
+  UdpDevice d(config_for(server, 5.0));
+  int first_lost = -1;
+  for (int n = 0; n < n_samples; ++n) {
+    d.read(n, n / 3000.0);
+    const bool dropped = n % 10 == 9 || n > 200;
+    const std::uint32_t expected = n > 200 ? 200u : static_cast<std::uint32_t>(dropped ? n - 1 : n);
+    INFO("tick " << n);
+    CHECK(d.newest().sequence == expected);
+    if (d.link_lost() && first_lost < 0) first_lost = n;
+    d.render(Vec3(0.0, 0.0, 2.0));
+  }
+  int expected_lost = 201;
+  while (!(expected_lost / 3000.0 - 200 / 3000.0 > 0.05)) ++expected_lost;
+  CHECK(expected_lost == 351);
+  CHECK(first_lost == expected_lost);
+  const UdpCounters& c = d.counters();
+  CHECK(c.received == 181);
+  CHECK(c.late == 219);
+  CHECK(c.held == 219);
+  CHECK(c.lost == 20);
+  CHECK(c.malformed == 0);
+  CHECK(c.link_lost == 1);
+
+  int status = -1;
+  const std::string out = server.finish(&status);
+  CHECK(status == 0);
+  const std::vector<PrintedForce> forces = printed_forces(out);
+  REQUIRE(forces.size() == 400u);
+  for (int n = 0; n < n_samples; ++n) {
+    INFO("force " << n);
+    CHECK(forces[n].sequence == static_cast<unsigned>(n + 1));
+    CHECK(forces[n].force == (n < expected_lost ? Vec3(0.0, 0.0, 2.0) : Vec3::Zero()));
+  }
+  CHECK(out.find("400 samples (219 lost, 400 datagrams sent)") != std::string::npos);
+}
+
+TEST_CASE("UDP bridge: device_server replays a trace's /servo hip and gimbal bit for bit", "[e2e][udp]") {
+  const std::string trace = std::string(GRASPSIM_SOURCE_DIR) + "/tests/golden/two_finger_lift.h5";
+  const auto hip = graspsim::recordings::read_dataset(trace, "/servo/fingers/thumb/hip").values;
+  const auto gimbal = graspsim::recordings::read_dataset(trace, "/servo/fingers/thumb/gimbal").values;
+  const std::size_t rows = hip.size() / 3;
+  REQUIRE(rows >= 2);
+  // Past the last row the server holds it: ask for 5 more samples than there are rows.
+  const int n_samples = static_cast<int>(rows) + 5;
+  Server server("--replay " + trace + " --finger thumb --samples " + std::to_string(n_samples));
+  CHECK(server.first_line().find("replay of") != std::string::npos);
+  UdpDevice d(config_for(server, 5.0));
+  for (int n = 0; n < n_samples; ++n) {
+    const DeviceSample s = d.read(n, n / 3000.0);
+    const std::size_t r = std::min<std::size_t>(n, rows - 1);
+    INFO("tick " << n);
+    for (int i = 0; i < 3; ++i) {
+      CHECK(std::memcmp(&s.position[i], &hip[3 * r + i], sizeof(double)) == 0);
+      CHECK(std::memcmp(&s.gimbal[i], &gimbal[3 * r + i], sizeof(double)) == 0);
+    }
+    d.render(Vec3::Zero());
+  }
+  int status = -1;
+  server.finish(&status);
+  CHECK(status == 0);
+}
+
+TEST_CASE("device_server: --help, and clear errors for bad options", "[e2e][udp]") {
+  using graspsim::test::shell;
+  const std::string ds = GRASPSIM_DEVICE_SERVER;
+  const auto help = shell(ds + " --help");
+  CHECK(help.status == 0);
+  CHECK(help.output.find("--lockstep") != std::string::npos);
+  const std::pair<std::string, std::string> bad[] = {
+      {"--rate -5", "--rate: must be positive"},
+      {"--port 70000", "--port: '70000' is not a whole number"},
+      {"--from 1,2", "--from: '1,2' is not three numbers"},
+      {"--motion spiral", "--motion: 'spiral' is not line or circle"},
+      {"--drop-every 1", "--drop-every: '1'"},
+      {"--replay x.h5", "--replay and --finger go together"},
+      {"--replay /no/such.h5 --finger thumb", "/no/such.h5: no such readable file"},
+      {"--replay " + std::string(GRASPSIM_SOURCE_DIR) + "/tests/golden/two_finger_lift.h5 --finger pinky",
+       "no dataset /servo/fingers/pinky/hip"},
+      {"--bind 1.2.3", "--bind: '1.2.3' is not an IPv4 address"},
+      {"--wobble", "unknown option '--wobble'"},
+      {"--samples", "--samples needs a value"},
+  };
+  for (const auto& [options, message] : bad) {
+    INFO(options);
+    const auto r = shell(ds + " " + options);
+    CHECK(r.status == 2);
+    CHECK(r.output.rfind("device_server: ", 0) == 0);
+    CHECK(r.output.find(message) != std::string::npos);
+  }
+}
