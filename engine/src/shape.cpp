@@ -3,6 +3,7 @@
 #include "graspsim/engine/shape.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <map>
@@ -526,6 +527,39 @@ TriangleMesh to_principal_frame(const TriangleMesh& mesh, PrincipalFrame& frame,
   TriangleMesh out = mesh;
   for (Vec3& x : out.vertices) x = frame.rotation.transpose() * (x - frame.centre);
   return out;
+}
+
+TriangleMesh icosphere_mesh(double r, int level) {
+  const double t = (1.0 + std::sqrt(5.0)) / 2.0;
+  TriangleMesh m;
+  m.vertices = {{-1, t, 0}, {1, t, 0}, {-1, -t, 0}, {1, -t, 0}, {0, -1, t}, {0, 1, t},
+                {0, -1, -t}, {0, 1, -t}, {t, 0, -1}, {t, 0, 1}, {-t, 0, -1}, {-t, 0, 1}};
+  m.triangles = {{0, 11, 5}, {0, 5, 1}, {0, 1, 7}, {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4},
+                 {11, 10, 2}, {10, 7, 6}, {7, 1, 8}, {3, 9, 4}, {3, 4, 2}, {3, 2, 6}, {3, 6, 8},
+                 {3, 8, 9}, {4, 9, 5}, {2, 4, 11}, {6, 2, 10}, {8, 6, 7}, {9, 8, 1}};
+  for (Vec3& v : m.vertices) v = v.normalized() * r;
+  for (int k = 0; k < level; ++k) {
+    std::map<std::pair<int, int>, int> mid;
+    const auto middle = [&](int a, int b) {
+      const auto key = std::minmax(a, b);
+      const auto it = mid.find(key);
+      if (it != mid.end()) return it->second;
+      m.vertices.push_back((m.vertices[a] + m.vertices[b]).normalized() * r);
+      const int i = static_cast<int>(m.vertices.size()) - 1;
+      mid.emplace(key, i);
+      return i;
+    };
+    std::vector<std::array<int, 3>> finer;
+    for (const auto& tri : m.triangles) {
+      const int a = middle(tri[0], tri[1]), b = middle(tri[1], tri[2]), c = middle(tri[2], tri[0]);
+      finer.push_back({tri[0], a, c});
+      finer.push_back({tri[1], b, a});
+      finer.push_back({tri[2], c, b});
+      finer.push_back({a, b, c});
+    }
+    m.triangles = finer;
+  }
+  return m;
 }
 
 }  // namespace graspsim

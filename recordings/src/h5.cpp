@@ -148,6 +148,19 @@ void write_scalar_attribute(hid_t object, const std::string& name, hid_t file_ty
   check(H5Awrite(attribute.get(), memory_type, value), where);
 }
 
+std::vector<std::string> member_names(hid_t dataset, const std::string& context) {
+  Handle type = checked(H5Dget_type(dataset), H5Tclose, context);
+  std::vector<std::string> names;
+  if (H5Tget_class(type.get()) != H5T_COMPOUND) return names;
+  const int n = H5Tget_nmembers(type.get());
+  for (int k = 0; k < n; ++k) {
+    char* name = H5Tget_member_name(type.get(), static_cast<unsigned>(k));
+    if (name != nullptr) names.emplace_back(name);
+    H5free_memory(name);
+  }
+  return names;
+}
+
 bool has_attribute(hid_t object, const std::string& name, const std::string& context) {
   const htri_t exists = H5Aexists(object, name.c_str());
   check(exists, context + ": cannot look for attribute '" + name + "'");

@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <mutex>
 #include <string>
+#include <vector>
 #include <utility>
 
 namespace graspsim::recordings::h5 {
@@ -89,6 +90,9 @@ void write_scalar_attribute(hid_t object, const std::string& name, hid_t file_ty
                             hid_t memory_type, const void* value, const std::string& context);
 
 bool has_attribute(hid_t object, const std::string& name, const std::string& context);
+// The member names of a compound dataset's element type (a schema 3 table), in order; empty for
+// any other dataset.
+std::vector<std::string> member_names(hid_t dataset, const std::string& context);
 // Variable- or fixed-length string attribute with one element.
 std::string read_string_attribute(hid_t object, const std::string& name,
                                   const std::string& context);

@@ -133,24 +133,10 @@ H5I_type_t object_type(hid_t loc, const std::string& path, const std::string& co
   return H5Iget_type(object.get());
 }
 
-// The names of the members of a compound dataset (a schema 3 table), or empty.
-std::vector<std::string> member_names(hid_t dataset, const std::string& context) {
-  h5::Handle type = h5::checked(H5Dget_type(dataset), H5Tclose, context);
-  std::vector<std::string> names;
-  if (H5Tget_class(type.get()) != H5T_COMPOUND) return names;
-  const int n = H5Tget_nmembers(type.get());
-  for (int k = 0; k < n; ++k) {
-    char* name = H5Tget_member_name(type.get(), static_cast<unsigned>(k));
-    if (name != nullptr) names.emplace_back(name);
-    H5free_memory(name);
-  }
-  return names;
-}
-
 bool is_table_dataset(hid_t loc, const std::string& path, const std::string& context) {
   h5::Handle d = h5::checked(H5Dopen2(loc, path.c_str(), H5P_DEFAULT), H5Dclose,
                              context + ": cannot open " + quoted(path));
-  return !member_names(d.get(), context).empty();
+  return !h5::member_names(d.get(), context).empty();
 }
 
 // Tables at the top of the file, by name: compound datasets (schema 3: one dataset per loop,
@@ -177,7 +163,7 @@ std::vector<std::string> datasets_below(const OpenTrace& t, const std::string& g
   if (object_type(t.file.get(), group, context) == H5I_DATASET) {
     h5::Handle d = h5::checked(H5Dopen2(t.file.get(), group.c_str(), H5P_DEFAULT), H5Dclose,
                                context + ": cannot open " + quoted("/" + group));
-    out = member_names(d.get(), context);
+    out = h5::member_names(d.get(), context);
     std::sort(out.begin(), out.end());
     return out;
   }

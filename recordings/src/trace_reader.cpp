@@ -49,20 +49,6 @@ struct Location {
   bool member_prefix = false;   // `member` names a group of members, not one
 };
 
-// The names of the members of compound dataset `dataset`.
-std::vector<std::string> member_names(hid_t dataset, const std::string& context) {
-  h5::Handle type = h5::checked(H5Dget_type(dataset), H5Tclose, context);
-  std::vector<std::string> names;
-  if (H5Tget_class(type.get()) != H5T_COMPOUND) return names;
-  const int n = H5Tget_nmembers(type.get());
-  for (int k = 0; k < n; ++k) {
-    char* name = H5Tget_member_name(type.get(), static_cast<unsigned>(k));
-    if (name != nullptr) names.emplace_back(name);
-    H5free_memory(name);
-  }
-  return names;
-}
-
 // Resolves `path` one link at a time; the first dataset on the way that is compound holds the
 // rest of the path as a member (or a prefix of members). nullopt-like: object invalid.
 Location locate(hid_t file, const std::string& path, const std::string& context) {
@@ -93,7 +79,7 @@ Location locate(hid_t file, const std::string& path, const std::string& context)
       while (!rest.empty() && rest.back() == '/') rest.pop_back();
       // An exact member wins; otherwise a prefix of members is a "group" of them.
       bool exact = false, below = false;
-      for (const std::string& m : member_names(object.get(), context)) {
+      for (const std::string& m : h5::member_names(object.get(), context)) {
         exact = exact || m == rest;
         below = below || m.rfind(rest + "/", 0) == 0;
       }

@@ -33,38 +33,7 @@ inline TriangleMesh moved(TriangleMesh m, const Mat3& rotation, const Vec3& shif
 
 // An icosahedron subdivided `level` times (20 * 4^level triangles), vertices on the sphere of
 // radius r: an inscribed polyhedron whose edges halve with each level.
-inline TriangleMesh icosphere(double r, int level) {
-  const double t = (1.0 + std::sqrt(5.0)) / 2.0;
-  TriangleMesh m;
-  m.vertices = {{-1, t, 0}, {1, t, 0}, {-1, -t, 0}, {1, -t, 0}, {0, -1, t}, {0, 1, t},
-                {0, -1, -t}, {0, 1, -t}, {t, 0, -1}, {t, 0, 1}, {-t, 0, -1}, {-t, 0, 1}};
-  m.triangles = {{0, 11, 5}, {0, 5, 1}, {0, 1, 7}, {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4},
-                 {11, 10, 2}, {10, 7, 6}, {7, 1, 8}, {3, 9, 4}, {3, 4, 2}, {3, 2, 6}, {3, 6, 8},
-                 {3, 8, 9}, {4, 9, 5}, {2, 4, 11}, {6, 2, 10}, {8, 6, 7}, {9, 8, 1}};
-  for (Vec3& v : m.vertices) v = v.normalized() * r;
-  for (int k = 0; k < level; ++k) {
-    std::map<std::pair<int, int>, int> mid;
-    const auto middle = [&](int a, int b) {
-      const auto key = std::minmax(a, b);
-      const auto it = mid.find(key);
-      if (it != mid.end()) return it->second;
-      m.vertices.push_back((m.vertices[a] + m.vertices[b]).normalized() * r);
-      const int i = static_cast<int>(m.vertices.size()) - 1;
-      mid.emplace(key, i);
-      return i;
-    };
-    std::vector<std::array<int, 3>> finer;
-    for (const auto& tri : m.triangles) {
-      const int a = middle(tri[0], tri[1]), b = middle(tri[1], tri[2]), c = middle(tri[2], tri[0]);
-      finer.push_back({tri[0], a, c});
-      finer.push_back({tri[1], b, a});
-      finer.push_back({tri[2], c, b});
-      finer.push_back({a, b, c});
-    }
-    m.triangles = finer;
-  }
-  return m;
-}
+inline TriangleMesh icosphere(double r, int level) { return icosphere_mesh(r, level); }
 
 // A prism over a simple polygon (counter-clockwise in xy, seen from +z), z in [-hz, hz]; each cap
 // a fan from the polygon's vertex `fan` (which must see every other vertex).

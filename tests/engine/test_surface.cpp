@@ -28,12 +28,6 @@ void enter_and_track(const SurfaceGeometry& g, double r, const Vec3& a, const Ve
   }
 }
 
-std::vector<Vec3> segment(const Vec3& a, const Vec3& b, int steps) {
-  std::vector<Vec3> out;
-  for (int i = 0; i <= steps; ++i) out.push_back(a + (b - a) * (static_cast<double>(i) / steps));
-  return out;
-}
-
 }  // namespace
 
 // Sphere of radius R, pad r: contact while |p| < R + r, SP = (R + r) p / |p|, depth R + r - |p|,

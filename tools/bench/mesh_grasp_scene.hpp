@@ -32,38 +32,7 @@ inline constexpr double kPebbleRest = 0.0235;   // m: centre height at rest (~1.
 inline constexpr double kSceneDuration = 4.0;   // s
 
 // An icosphere of unit radius subdivided `level` times (20 x 4^level triangles), outward.
-inline TriangleMesh unit_icosphere(int level) {
-  const double t = (1.0 + std::sqrt(5.0)) / 2.0;
-  TriangleMesh m;
-  m.vertices = {{-1, t, 0}, {1, t, 0}, {-1, -t, 0}, {1, -t, 0}, {0, -1, t}, {0, 1, t},
-                {0, -1, -t}, {0, 1, -t}, {t, 0, -1}, {t, 0, 1}, {-t, 0, -1}, {-t, 0, 1}};
-  m.triangles = {{0, 11, 5}, {0, 5, 1}, {0, 1, 7}, {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4},
-                 {11, 10, 2}, {10, 7, 6}, {7, 1, 8}, {3, 9, 4}, {3, 4, 2}, {3, 2, 6}, {3, 6, 8},
-                 {3, 8, 9}, {4, 9, 5}, {2, 4, 11}, {6, 2, 10}, {8, 6, 7}, {9, 8, 1}};
-  for (Vec3& v : m.vertices) v.normalize();
-  for (int k = 0; k < level; ++k) {
-    std::map<std::pair<int, int>, int> mid;
-    const auto middle = [&](int a, int b) {
-      const auto key = std::minmax(a, b);
-      const auto it = mid.find(key);
-      if (it != mid.end()) return it->second;
-      m.vertices.push_back((m.vertices[a] + m.vertices[b]).normalized());
-      const int i = static_cast<int>(m.vertices.size()) - 1;
-      mid.emplace(key, i);
-      return i;
-    };
-    std::vector<std::array<int, 3>> next;
-    for (const auto& tri : m.triangles) {
-      const int a = middle(tri[0], tri[1]), b = middle(tri[1], tri[2]), c = middle(tri[2], tri[0]);
-      next.push_back({tri[0], a, c});
-      next.push_back({tri[1], b, a});
-      next.push_back({tri[2], c, b});
-      next.push_back({a, b, c});
-    }
-    m.triangles = std::move(next);
-  }
-  return m;
-}
+inline TriangleMesh unit_icosphere(int level) { return icosphere_mesh(1.0, level); }
 
 // The scene's model (sleep off, as Model's default).
 inline Model mesh_grasp_model() {

@@ -84,6 +84,11 @@ void check_closed_mesh(const TriangleMesh& mesh);
 // The mesh without the vertices no triangle uses (indices renumbered, order kept).
 TriangleMesh without_unused_vertices(const TriangleMesh& mesh);
 
+// An icosahedron subdivided `level` times (20 * 4^level triangles, counter-clockwise seen from
+// outside), every vertex on the sphere of `radius` (m): an inscribed polyhedron whose edges
+// halve with each level. For tests, benchmarks and test scenes (5,120 triangles at level 4).
+TriangleMesh icosphere_mesh(double radius, int level);
+
 // The faces of a closed convex mesh: adjacent triangles in one plane merged into one face
 // (within 1e-6 of the mesh's size, so files written with 6 to 7 digits pass), each face's
 // vertices counter-clockwise seen from outside, its unit normal the area-weighted mean of its
