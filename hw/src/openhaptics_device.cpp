@@ -105,7 +105,7 @@ struct Slot {
   std::array<double, 3> servo_force{0.0, 0.0, 0.0};   // N, OpenHaptics axes: what it renders
   std::uint64_t seen_requests = 0;
   std::uint64_t frames_since_request = 0;
-  bool faulted = false;
+  HDErrorInfo fault{HD_SUCCESS, 0, HD_INVALID_HANDLE};   // first HD error in a frame; sticky
 };
 
 // Every open Phantom, and the one scheduler callback that serves them all. The device list only
@@ -191,17 +191,18 @@ HDCallbackCode HDCALLBACK Session::servo_frame(void* data) {
       s->box.mutex.unlock();
     }
     s->frames_since_request = fresh ? 0 : s->frames_since_request + 1;
-    if (s->frames_since_request >= kStallFrames || s->faulted) s->servo_force = {0.0, 0.0, 0.0};
+    if (s->frames_since_request >= kStallFrames || HD_DEVICE_ERROR(s->fault))
+      s->servo_force = {0.0, 0.0, 0.0};
     hdSetDoublev(HD_CURRENT_FORCE, s->servo_force.data());
     hdEndFrame(s->handle);
     const HDErrorInfo e = take_error();
-    if (HD_DEVICE_ERROR(e)) s->faulted = true;   // zero force from the next frame on
+    if (HD_DEVICE_ERROR(e) && !HD_DEVICE_ERROR(s->fault)) s->fault = e;   // zero from next frame
     if (s->box.mutex.try_lock()) {
       s->box.position_mm = position;
       s->box.gimbal = gimbal;
       s->box.buttons = static_cast<std::uint32_t>(buttons);
       ++s->box.frames;
-      if (HD_DEVICE_ERROR(e) && !HD_DEVICE_ERROR(s->box.fault)) s->box.fault = e;
+      s->box.fault = s->fault;   // published on the first frame the mailbox is free
       s->box.mutex.unlock();
     }
   }
