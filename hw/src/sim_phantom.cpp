@@ -50,7 +50,10 @@ SimPhantom::SimPhantom(const SimPhantomConfig& config, std::unique_ptr<Trajector
       hand_(std::move(hand)),
       safety_(safety_config(config, model_)),
       period_(1.0 / config.device_rate_hz),
-      b_(std::isnan(config.damping) ? model_.damping : config.damping) {
+      b_(std::isnan(config.damping) ? model_.damping : config.damping),
+      mu_(std::isnan(config.friction) ? model_.backdrive_friction : config.friction),
+      res_(std::isnan(config.encoder_resolution) ? model_.encoder_resolution
+                                                 : config.encoder_resolution) {
   require(hand_ != nullptr, "hand: a trajectory is required");
   require(std::isfinite(config.device_rate_hz) && config.device_rate_hz > 0.0,
           "device_rate_hz must be finite and > 0 (Hz), got " + std::to_string(config.device_rate_hz));
@@ -59,6 +62,9 @@ SimPhantom::SimPhantom(const SimPhantomConfig& config, std::unique_ptr<Trajector
   require(std::isfinite(config.hand_damping) && config.hand_damping >= 0.0,
           "hand_damping must be finite and >= 0 (N s/m), got " + std::to_string(config.hand_damping));
   require(std::isfinite(b_) && b_ >= 0.0, "damping must be finite and >= 0 (N s/m), got " + std::to_string(b_));
+  require(std::isfinite(mu_) && mu_ >= 0.0, "friction must be finite and >= 0 (N), got " + std::to_string(mu_));
+  require(std::isfinite(res_) && res_ >= 0.0,
+          "encoder_resolution must be finite and >= 0 (m), got " + std::to_string(res_));
   require(config.substeps >= 1 && config.substeps <= 1000,
           "substeps must be in [1, 1000], got " + std::to_string(config.substeps));
   require(config.workspace_center.allFinite(), "workspace_center must be finite (m)");
@@ -69,10 +75,11 @@ SimPhantom::SimPhantom(const SimPhantomConfig& config, std::unique_ptr<Trajector
   const Vec3 half = 0.5 * model_.workspace;
   lo_ = config.workspace_center - half;
   hi_ = config.workspace_center + half;
-  for (int i = 0; i < 3; ++i) {
-    count_lo_[i] = std::ceil(-half[i] / model_.encoder_resolution);
-    count_hi_[i] = std::floor(half[i] / model_.encoder_resolution);
-  }
+  if (res_ > 0.0)
+    for (int i = 0; i < 3; ++i) {
+      count_lo_[i] = std::ceil(-half[i] / res_);
+      count_hi_[i] = std::floor(half[i] / res_);
+    }
   hand_now_ = hand_->sample(0.0);
   x_ = hand_now_.position.cwiseMax(lo_).cwiseMin(hi_);
   sample_.position = encoder();
@@ -85,11 +92,12 @@ std::string SimPhantom::describe() const {
 }
 
 Vec3 SimPhantom::encoder() const {
+  if (res_ == 0.0) return x_;   // unquantised; x_ is inside the box already
   Vec3 p;
   for (int i = 0; i < 3; ++i) {
-    double q = std::nearbyint((x_[i] - config_.workspace_center[i]) / model_.encoder_resolution);
+    double q = std::nearbyint((x_[i] - config_.workspace_center[i]) / res_);
     q = std::fmin(std::fmax(q, count_lo_[i]), count_hi_[i]);
-    p[i] = config_.workspace_center[i] + q * model_.encoder_resolution;
+    p[i] = config_.workspace_center[i] + q * res_;
   }
   return p;
 }
@@ -104,7 +112,7 @@ void SimPhantom::step() {
   const int n = config_.substeps;
   const double h = period_ / n;
   const double m = model_.tip_mass;
-  const double stop = h * model_.backdrive_friction / m;   // m/s: friction's speed change per step
+  const double stop = h * mu_ / m;   // m/s: friction's speed change per step
   for (int s = 0; s < n; ++s) {
     const Vec3 xh = xh0 + vh * (h * s);
     const Vec3 f = config_.hand_stiffness * (xh - x_) + config_.hand_damping * (vh - v_) + motor_;

@@ -13,6 +13,8 @@
 #include <string>
 #include <vector>
 
+#include <Eigen/Eigenvalues>
+
 #include "graspsim/hw/sim_phantom.hpp"
 #include "graspsim/hw/trajectory.hpp"
 
@@ -281,4 +283,103 @@ TEST_CASE("sim-phantom: a bad configuration names the field", "[hw][sim_phantom]
   SimPhantom dev(SimPhantomConfig{}, hold(Vec3::Zero()));
   CHECK_THROWS_AS(dev.read(0, std::numeric_limits<double>::quiet_NaN()), std::invalid_argument);
   CHECK(dev.describe() == "sim-phantom (Phantom Premium 1.5, 1000 Hz)");
+}
+
+namespace {
+
+// The linear loop of the passivity test without friction or quantisation, written out as the
+// map of one device tick: state (e, v, e_k) with e the tip's offset from equilibrium along x,
+// v its velocity, e_k the offset sampled at the start of the tick; the spring force -K e_k is
+// held over the tick while the tip takes `substeps` steps of the scheme in sim_phantom.cpp
+// (v' = (v + h (-k_h e - b_h v - K e_k) / m) / (1 + h b / m), e' = e + h v'), then e_k = e.
+// Returns the spectral radius: the oscillation grows by that factor per device tick.
+double tick_spectral_radius(double rate, int substeps, double m, double b, double k_h, double b_h,
+                            double stiffness) {
+  const double h = 1.0 / rate / substeps;
+  Eigen::Matrix3d map;
+  for (int j = 0; j < 3; ++j) {
+    Eigen::Vector3d s = Eigen::Vector3d::Unit(j);
+    for (int i = 0; i < substeps; ++i) {
+      const double v = (s[1] + h / m * (-k_h * s[0] - b_h * s[1] - stiffness * s[2])) / (1.0 + h * b / m);
+      s[0] += h * v;
+      s[1] = v;
+    }
+    s[2] = s[0];
+    map.col(j) = s;
+  }
+  return Eigen::EigenSolver<Eigen::Matrix3d>(map).eigenvalues().cwiseAbs().maxCoeff();
+}
+
+}  // namespace
+
+// The passivity bound as a law, in the linear regime (no friction, no quantisation, a two-sided
+// spring K around x_w = 2 um). The stability boundary K* of the closed loop, from the spectral
+// radius of the tick map above, is the continuous bound K_c = 2 (b + b_h) / T shifted by the
+// integrator: semi-implicit Euler's position leads by h/2 (x_{n+1} uses v_{n+1}), so the held
+// spring lags by (T - h)/2 instead of T/2, and K* = 2 (b + b_h) / (T - h) = K_c / (1 - 1/N), N
+// the substeps (2 % at N = 50; 11 % at N = 10). The next term is of order delta = (b + b_h) T / m
+// (<= 0.027 here): tolerance delta / 2 (measured about delta / 6), swept over N = 10 and 50.
+// And the simulated device follows that map: the envelope of the tip's oscillation grows or
+// decays at sigma = ln(rho) / T. The envelope is read as the largest offset in two windows
+// 0.2 s apart; the first peak in a window comes within half a period (<= 12 ms) of its start, so
+// the reading is good to |sigma| x 12 ms at each end: tolerance 12 % of |sigma| + 0.2/s.
+TEST_CASE("sim-phantom: the linear loop's stability boundary is 2(b + b_h)/T and the tip follows it",
+          "[hw][sim_phantom][passivity][law]") {
+  for (double rate : {1000.0, 3000.0}) {
+    for (double hand_damping : {0.5, 2.0}) {
+      SimPhantomConfig c;
+      c.device_rate_hz = rate;
+      c.hand_damping = hand_damping;
+      c.friction = 0.0;
+      c.encoder_resolution = 0.0;
+      c.rise_time = 0.0;
+      c.thermal_time_constant = 1e9;
+      const DeviceModel& model = device_model(c.model);
+      const double b = model.damping, m = model.tip_mass;
+      const double k_crit = 2.0 * (b + hand_damping) * rate;
+      const double delta = (b + hand_damping) / rate / m;
+      for (int substeps : {10, 50}) {
+        const double k_scheme = k_crit / (1.0 - 1.0 / substeps);
+        double lo = 0.25 * k_crit, hi = 4.0 * k_crit;
+        const auto rho_n = [&](double k) {
+          return tick_spectral_radius(rate, substeps, m, b, c.hand_stiffness, hand_damping, k);
+        };
+        REQUIRE(rho_n(lo) < 1.0);
+        REQUIRE(rho_n(hi) > 1.0);
+        for (int i = 0; i < 60; ++i) (rho_n(0.5 * (lo + hi)) < 1.0 ? lo : hi) = 0.5 * (lo + hi);
+        INFO("rate " << rate << " Hz, b + b_h " << b + hand_damping << " N s/m, N = " << substeps
+                     << ": boundary K* = " << lo << " N/m, K_c = " << k_crit
+                     << " N/m, K*/K_c = " << lo / k_crit << ", K* / (K_c / (1 - 1/N)) - 1 = "
+                     << lo / k_scheme - 1.0 << " (tol " << delta / 2 << ")");
+        CHECK(std::abs(lo / k_scheme - 1.0) <= delta / 2);
+      }
+      const auto rho = [&](double k) {
+        return tick_spectral_radius(rate, c.substeps, m, b, c.hand_stiffness, hand_damping, k);
+      };
+
+      for (double ratio : {0.5, 0.8, 1.25, 2.0}) {
+        const double k = ratio * k_crit;
+        const double x_w = 0.002e-3;   // m: small, so the fastest growth (x160) stays far from the peak force
+        SimPhantom dev(c, hold(Vec3::Zero()));
+        const double x_eq = k * x_w / (k + c.hand_stiffness);
+        double a1 = 0.0, a2 = 0.0;
+        const auto n = static_cast<std::int64_t>(std::llround(0.4 * rate));
+        for (std::int64_t i = 0; i <= n; ++i) {
+          const double t = static_cast<double>(i) / rate;
+          const DeviceSample s = dev.read(i, t);
+          dev.render(Vec3(-k * (s.position.x() - x_w), 0.0, 0.0));
+          const double e = std::abs(dev.tip_position().x() - x_eq);
+          if (t >= 0.1 && t < 0.2) a1 = std::max(a1, e);
+          if (t >= 0.3 && t < 0.4) a2 = std::max(a2, e);
+        }
+        const double sigma_pred = std::log(rho(k)) * rate;   // 1/s
+        const double sigma_meas = std::log(a2 / a1) / 0.2;   // 1/s
+        INFO("K = " << ratio << " K_c: sigma measured " << sigma_meas << "/s, predicted "
+                    << sigma_pred << "/s");
+        CHECK(std::abs(sigma_meas - sigma_pred) <= 0.12 * std::abs(sigma_pred) + 0.2);
+        CHECK((sigma_meas > 0.0) == (ratio > 1.0));
+        CHECK(dev.motor_force().norm() < model.peak_force);   // never saturated: still linear
+      }
+    }
+  }
 }

@@ -25,10 +25,16 @@ struct SimPhantomConfig {
   // and 1-4 N s/m depending on grip force); mid-range values.
   double hand_stiffness = 300.0;       // N/m: k_h, spring from the stylus to the trajectory
   double hand_damping = 2.0;           // N s/m: b_h, on the velocity relative to the trajectory
-  int substeps = 10;                   // stylus integration steps per device tick (>= 1)
+  // Stylus integration steps per device tick (>= 1). Semi-implicit Euler's position leads by
+  // half a step, which shortens the ZOH's effective delay from T/2 to (T - h)/2 and moves the
+  // sampled-wall stability bound from 2b/T to 2b/(T - h): 50 keeps that bias at 2 %.
+  int substeps = 50;
   Vec3 workspace_center{0.0, 0.0, 0.0};   // m: centre of the workspace box and encoder zero, in
                                           // the hand trajectory's frame
   double damping = std::numeric_limits<double>::quiet_NaN();   // N s/m: b; NaN = the model's
+  double friction = std::numeric_limits<double>::quiet_NaN();  // N: mu; NaN = the model's
+  // m: one encoder count; NaN = the model's, 0 = no quantisation (for tests of the linear law)
+  double encoder_resolution = std::numeric_limits<double>::quiet_NaN();
   double rise_time = 1.0;              // s: force ramp-in (ForceSafetyConfig::rise_time)
   double stall_timeout = 0.05;         // s: zero force after this long without a render
   double thermal_time_constant = 10.0; // s: tau of the thermal derating (estimate)
@@ -54,6 +60,7 @@ class SimPhantom final : public Device {
   const Vec3& tip_velocity() const { return v_; }    // m/s: tip velocity
   const Vec3& motor_force() const { return motor_; } // N: force the motors applied in the last device tick
   double damping() const { return b_; }              // N s/m: b in use
+  double friction() const { return mu_; }             // N: mu in use
 
  protected:
   void output(const Vec3& force) override;
@@ -68,8 +75,10 @@ class SimPhantom final : public Device {
   ForceSafety safety_;
   double period_;                // s: T = 1 / device_rate_hz
   double b_;                     // N s/m: device viscous damping
+  double mu_;                    // N: Coulomb backdrive friction
+  double res_;                   // m: encoder count, 0 = none
   Vec3 lo_, hi_;                 // m: workspace box corners
-  Vec3 count_lo_, count_hi_;     // encoder counts (integers stored as double) at the box corners
+  Vec3 count_lo_{0.0, 0.0, 0.0}, count_hi_{0.0, 0.0, 0.0};   // encoder counts (integers stored as double) at the box corners
   std::int64_t device_tick_ = 0;
   double clock_ = 0.0;           // s: time of the last read, stamps render requests
   Vec3 x_{0.0, 0.0, 0.0};        // m
