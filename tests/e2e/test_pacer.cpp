@@ -5,9 +5,12 @@
 // device and stops the run.
 #include <catch2/catch.hpp>
 
+#include <atomic>
 #include <cmath>
+#include <functional>
 #include <cstdint>
 #include <memory>
+#include <stdexcept>
 #include <vector>
 
 #include "app/pacer.hpp"
@@ -94,8 +97,10 @@ class SlowFinger final : public hw::Device {
   SlowFinger(std::unique_ptr<hw::Trajectory> t, FakeClock& clock, std::int64_t slow_tick, std::int64_t work,
              hw::Vec3& last)
       : t_(std::move(t)), clock_(clock), slow_tick_(slow_tick), work_(work), last_(last) {}
+  std::function<void(std::int64_t)> on_tick;   // called at every read, if set
   hw::DeviceSample read(std::int64_t tick, double time) override {
     if (tick == slow_tick_) clock_.t += work_;
+    if (on_tick) on_tick(tick);
     hw::DeviceSample s;
     s.position = t_->sample(time).position;
     return s;
@@ -161,4 +166,46 @@ TEST_CASE("A paced run that stalls past the timeout releases every device and st
   CHECK(r.servo_ticks == 4500);
   CHECK(last[0] == hw::Vec3::Zero());
   CHECK(last[1] == hw::Vec3::Zero());
+}
+
+TEST_CASE("A paced run sees Ctrl-C at the next tick and releases every device", "[pacer][e2e][safety]") {
+  // Unpaced, the interrupt is polled every 3000 ticks (1 s simulated); paced (a hand on a real
+  // device) at every tick: raised during tick 4500's read, the run stops after that tick, with
+  // 4501 servo ticks done, and every device's last force is zero.
+  const auto scenario = scripting::Scenario::load(kLift);
+  FakeClock clock;
+  app::Pacer pacer(clock, 3000, app::kStallTimeout);
+  std::vector<hw::Vec3> last(2, hw::Vec3::Ones());
+  std::atomic<bool> interrupt{false};
+  app::RunOptions o;
+  o.out = kTmp + "/pacer_interrupt.h5";
+  o.pacer = &pacer;
+  o.interrupt = &interrupt;
+  o.make_device = [&](std::size_t f) -> std::unique_ptr<hw::Device> {
+    auto d = std::make_unique<SlowFinger>(scenario.make_trajectory(f), clock, -1, 0, last[f]);
+    if (f == 1) d->on_tick = [&](std::int64_t n) { if (n == 4500) interrupt.store(true); };
+    return d;
+  };
+  const app::RunResult r = app::run_scenario(scenario, o);
+  CHECK(r.interrupted);
+  CHECK(r.servo_ticks == 4501);
+  CHECK(last[0] == hw::Vec3::Zero());
+  CHECK(last[1] == hw::Vec3::Zero());
+}
+
+TEST_CASE("A device that fails to open releases the ones already open", "[e2e][safety]") {
+  // The index device's factory throws (a device that does not open): the thumb's device, built
+  // first, gets zero force; the error names the failure.
+  const auto scenario = scripting::Scenario::load(kLift);
+  FakeClock clock;
+  std::vector<hw::Vec3> last(2, hw::Vec3::Ones());
+  app::RunOptions o;
+  o.out = kTmp + "/device_open_fails.h5";
+  o.make_device = [&](std::size_t f) -> std::unique_ptr<hw::Device> {
+    if (f == 1) throw std::runtime_error("phantom 'Right': HD_DEVICE_NOT_FOUND");
+    return std::make_unique<SlowFinger>(scenario.make_trajectory(f), clock, -1, 0, last[f]);
+  };
+  const app::RunResult r = app::run_scenario(scenario, o);
+  CHECK_THAT(r.error, Catch::Contains("HD_DEVICE_NOT_FOUND"));
+  CHECK(last[0] == hw::Vec3::Zero());
 }
