@@ -15,6 +15,11 @@ namespace graspsim::app {
 // force for longer than that before every device is released.
 inline constexpr double kStallTimeout = 0.02;
 
+// The force ramp of graspsim run with a real device (s, RunOptions::force_ramp): rendered
+// forces rise linearly from 0 over the first half second, slower than a hand's reflex, so a
+// device that starts inside an object (or a wrong mapping) pushes gently before it pushes fully.
+inline constexpr double kForceRamp = 0.5;
+
 class MonotonicClock {
  public:
   virtual ~MonotonicClock() = default;

@@ -149,6 +149,9 @@ ReplayPlan load(const std::string& trace, const ReplayOptions& options) {
                       std::to_string(recordings::kSchemaVersion) + ")");
   }
   plan.status = required_string(trace, "status");
+  // The run's force ramp (0 in traces from before it was recorded): rendered forces again.
+  if (recordings::has_attribute(trace, "/", "force_ramp"))
+    plan.force_ramp = recordings::read_double_attribute(trace, "/", "force_ramp");
   plan.scenario_path = required_string(trace, "scenario_path");
   plan.scenario_source_hash = required_string(trace, "scenario_source_hash");
   const std::string source = required_string(trace, "scenario_source");
@@ -288,6 +291,7 @@ RunOptions ReplayPlan::run_options(const std::string& out) const {
   options.out = out;
   options.overrides = overrides;
   options.max_ticks = recorded_ticks;
+  options.force_ramp = force_ramp;
   options.attributes.emplace_back("replay_of", replay_of());
   for (const RecordedFinger& r : fingers) options.record_devices.push_back(r.device.has_value());
   options.make_device = [this](std::size_t f) -> std::unique_ptr<hw::Device> {

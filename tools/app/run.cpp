@@ -218,6 +218,7 @@ RunResult run_scenario(const scripting::Scenario& scenario, const RunOptions& op
   std::string warnings;
   for (const std::string& w : result.warnings) warnings += w + "\n";
   writer.set_attribute("warnings", warnings);
+  writer.set_attribute("force_ramp", options.force_ramp);
 
   const auto start = Clock::now();
   std::optional<Simulation> sim_holder;
@@ -302,7 +303,12 @@ RunResult run_scenario(const scripting::Scenario& scenario, const RunOptions& op
       }
       check_due(n);
       sim.step(input, record);
-      for (std::size_t f = 0; f < devices.size(); ++f) rendered[f] = devices[f]->render(record.servo[f].force);
+      if (options.force_ramp > 0.0 && t < options.force_ramp) {
+        const double ramp = t / options.force_ramp;   // 1: linear rise from 0 at t = 0
+        for (std::size_t f = 0; f < devices.size(); ++f) rendered[f] = devices[f]->render(ramp * record.servo[f].force);
+      } else {
+        for (std::size_t f = 0; f < devices.size(); ++f) rendered[f] = devices[f]->render(record.servo[f].force);
+      }
       TickPace pace;
       if (options.pacer) {
         // The forces are out: wait for this tick's deadline (or count it late). A stall releases

@@ -48,6 +48,11 @@ struct RunOptions {
   // that thread stays an ordinary one).
   Pacer* pacer = nullptr;
   bool realtime = false;
+  // Force ramp (s, 0: none): every rendered force is scaled by min(1, t / force_ramp) from the
+  // start, so a hand that starts inside an object is not kicked (graspsim run: kForceRamp with a
+  // real device). Only what devices render changes, never the engine; root attribute
+  // `force_ramp`, which a replay applies again.
+  double force_ramp = 0.0;
 };
 
 // A device whose samples carry their recorded overrun flag (a replay of /devices rows): the

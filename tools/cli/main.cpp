@@ -244,6 +244,7 @@ int run_command(const std::vector<std::string>& args) {
   if (plan.any_real()) {
     pacer.emplace(steady, scenario->model().rates.servo, graspsim::app::kStallTimeout);
     options.pacer = &*pacer;
+    options.force_ramp = graspsim::app::kForceRamp;
     const std::string why = graspsim::app::probe_realtime();
     options.realtime = why.empty();
     if (!why.empty()) std::cerr << "graspsim: warning: " << why << "\n";
