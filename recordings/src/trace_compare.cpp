@@ -149,8 +149,21 @@ std::vector<std::string> top_groups(const OpenTrace& t) {
             context + ": cannot list the root group");
   for (const std::string& l : links) {
     const H5I_type_t type = object_type(t.file.get(), l, context);
-    if (type == H5I_GROUP || (type == H5I_DATASET && is_table_dataset(t.file.get(), l, context)))
-      groups.push_back(l);
+    if (type == H5I_DATASET && is_table_dataset(t.file.get(), l, context)) groups.push_back(l);
+    if (type != H5I_GROUP) continue;
+    // A group of tables (/devices/<finger>, issue 6) is compared table by table; any other
+    // group (a schema 2 loop: one dataset per column) as one table.
+    std::vector<std::string> children, tables;
+    h5::Handle g = h5::checked(H5Gopen2(t.file.get(), l.c_str(), H5P_DEFAULT), H5Gclose,
+                               context + ": cannot open group " + quoted("/" + l));
+    hsize_t child_index = 0;
+    h5::check(H5Literate(g.get(), H5_INDEX_NAME, H5_ITER_INC, &child_index, collect_link, &children),
+              context + ": cannot list group " + quoted("/" + l));
+    for (const std::string& c : children)
+      if (object_type(g.get(), c, context) == H5I_DATASET && is_table_dataset(g.get(), c, context))
+        tables.push_back(l + "/" + c);
+    if (tables.empty()) groups.push_back(l);
+    else groups.insert(groups.end(), tables.begin(), tables.end());
   }
   return groups;
 }

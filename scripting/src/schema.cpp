@@ -394,6 +394,20 @@ FingerParts finger(const LuaValue& value, std::size_t index) {
     fail(r.at("max_force"), "must be > 0 N and finite (got " +
                                 format_short(out.setup.limits.max_force) + ")");
   }
+  if (const LuaValue* device = r.get("device")) {
+    // The device's default spec and workspace mapping (world = offset + scale R p); the spec's
+    // syntax is checked by the CLI's device factory, which knows the kinds (tools/app/devices.cpp).
+    const Record d(*device, r.at("device"), TableKind::kDevice);
+    out.setup.device = d.string_or("default", out.setup.device);
+    if (out.setup.device.empty()) fail(d.at("default"), "must not be empty (\"scripted\", \"sim-phantom\", ...)");
+    out.setup.mapping.scale = d.number_or("scale", 1.0);
+    if (!(out.setup.mapping.scale > 0.0) || std::isinf(out.setup.mapping.scale)) {
+      fail(d.at("scale"), "must be > 0 and finite (m world per m device; got " +
+                              format_short(out.setup.mapping.scale) + ")");
+    }
+    out.setup.mapping.offset = d.vec3_or("offset", out.setup.mapping.offset);
+    out.setup.mapping.rotation = d.vec3_or("rotation", out.setup.mapping.rotation);
+  }
   const Where at_trajectory = r.at("trajectory");
   const LuaValue& trajectory = r.required(
       "trajectory", "waypoints { {t = 0, p = {x, y, z}}, ... } or a function(t) returning x, y, z");
@@ -489,7 +503,8 @@ const std::vector<std::string>& fields_of(TableKind kind) {
       "name", "shape", "size", "radius", "length", "file", "scale", "mass", "density", "inertia",
       "position", "orientation", "velocity", "angular_velocity", "material"};
   static const std::vector<std::string> kFinger = {
-      "name", "stiffness", "damping", "radius", "max_force", "trajectory", "interpolation"};
+      "name", "stiffness", "damping", "radius", "max_force", "trajectory", "interpolation", "device"};
+  static const std::vector<std::string> kDevice = {"default", "scale", "offset", "rotation"};
   static const std::vector<std::string> kWaypoint = {"t", "p", "pitch"};
   static const std::vector<std::string> kExpectation = {"what", "at", "check"};
   static const std::vector<std::string> kNone;
@@ -502,6 +517,7 @@ const std::vector<std::string>& fields_of(TableKind kind) {
     case TableKind::kGrasp: return kGrasp;
     case TableKind::kObject: return kObject;
     case TableKind::kFinger: return kFinger;
+    case TableKind::kDevice: return kDevice;
     case TableKind::kWaypoint: return kWaypoint;
     case TableKind::kExpectation: return kExpectation;
     default: return kNone;
@@ -533,7 +549,10 @@ TableKind child_kind(TableKind parent, const LuaKey& key) {
       }
       return TableKind::kValue;
     case TableKind::kFinger:
+      if (!key.is_index && name == "device") return TableKind::kDevice;
       return !key.is_index && name == "trajectory" ? TableKind::kWaypoints : TableKind::kValue;
+    case TableKind::kDevice:
+      return !key.is_index && (name == "offset" || name == "rotation") ? TableKind::kVector : TableKind::kValue;
     case TableKind::kWaypoint:
       return !key.is_index && name == "p" ? TableKind::kVector : TableKind::kValue;
     case TableKind::kObjects: return TableKind::kObject;

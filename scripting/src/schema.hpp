@@ -19,6 +19,7 @@ namespace graspsim::scripting::detail {
 enum class TableKind {
   kRoot, kRates, kFloor, kMaterial, kGrasp, kSleep,
   kObjects, kObject, kFingers, kFinger, kWaypoints, kWaypoint, kExpects, kExpectation,
+  kDevice,   // a finger's device = { default, scale, offset, rotation }
   kVector,   // {x, y, z} or {w, x, y, z}
   kValue,    // not a table of the format (a number, a string, a function...)
 };

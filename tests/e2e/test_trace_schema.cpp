@@ -79,6 +79,7 @@ std::string generic(const std::string& path) {
     std::string p = parts[i];
     if (i >= 2 && parts[i - 1] == "fingers") p = "<finger>";
     if (i >= 2 && parts[i - 1] == "objects") p = "<object>";
+    if (i == 2 && parts[1] == "devices") p = "<finger>";
     out += "/" + p;
   }
   return out.empty() ? "/" : out;
@@ -218,6 +219,7 @@ TEST_CASE("recordings/README.md documents exactly the datasets and attributes of
   app::RunOptions options;
   options.out = kTmp + "/e2e_schema.h5";
   options.overrides = load.sets;
+  options.record_devices = {false, true};   // the index finger's samples in /devices/index
   const app::RunResult result = app::run_scenario(scenario, options);
   REQUIRE(result.error.empty());
 

@@ -92,8 +92,8 @@ TEST_CASE("an unknown field is named with its place and the closest known name",
         ": fingers[1] 'thumb': trajectory[2]: unknown field 'pos' (known fields: t, p, pitch)");
   const Broken two = broken("two_unknown_fields", "max_force = 8", "zeta = 1, alpha = 2");
   CHECK(two.message == two.path + ": fingers[1] 'thumb': unknown field 'alpha' (known fields: "
-        "name, stiffness, damping, radius, max_force, trajectory, interpolation); unknown field 'zeta' (known "
-        "fields: name, stiffness, damping, radius, max_force, trajectory, interpolation)");
+        "name, stiffness, damping, radius, max_force, trajectory, interpolation, device); unknown field 'zeta' (known "
+        "fields: name, stiffness, damping, radius, max_force, trajectory, interpolation, device)");
   const Broken expectation = broken("unknown_expect_field", "at = 2,", "when = 2,");
   CHECK_THAT(expectation.message, StartsWith(expectation.path + ": expect[1] 'box lifted': unknown field 'when'"));
 }

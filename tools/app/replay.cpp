@@ -5,9 +5,12 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <cstdio>
+#include <cstdlib>
 #include <sstream>
 
 #include "graspsim/hw/replay_device.hpp"
+#include "graspsim/hw/sample_clock.hpp"
 #include "graspsim/recordings/trace_reader.hpp"
 #include "graspsim/recordings/trace_recorder.hpp"
 
@@ -43,6 +46,81 @@ std::vector<hw::Vec3> read_vec3(const std::string& trace, const std::string& pat
   return rows;
 }
 
+// A device's recorded samples, row n at servo tick n, in its own frame, with their own clock
+// and the recorded pacing (so the run loop rewrites the same /devices row). The finger's script
+// still runs alongside, as for ReplayDevice.
+class DeviceRowsReplay final : public hw::Device, public hw::SampleClock, public RecordedPacing {
+ public:
+  DeviceRowsReplay(const RecordedDeviceRows& rows, hw::DeviceLimits limits, std::string source,
+                   std::unique_ptr<hw::Trajectory> script)
+      : rows_(rows), limits_(limits), source_(std::move(source)), script_(std::move(script)) {}
+  hw::DeviceSample read(std::int64_t tick, double time) override {
+    if (tick < 0 || tick >= static_cast<std::int64_t>(rows_.position.size()))
+      throw std::out_of_range("replay of " + source_ + ": no recorded sample for servo tick " + std::to_string(tick));
+    if (script_) script_->sample(time);
+    const auto n = static_cast<std::size_t>(tick);
+    hw::DeviceSample s;
+    s.position = rows_.position[n];
+    s.gimbal = rows_.gimbal[n];
+    s.buttons = rows_.buttons[n];
+    time_ = rows_.device_time[n];
+    overrun_ = rows_.overrun[n];
+    return s;
+  }
+  hw::DeviceLimits limits() const override { return limits_; }
+  std::string describe() const override { return "replay of " + source_; }
+  double sample_time() const override { return time_; }
+  bool recorded_overrun() const override { return overrun_; }
+
+ protected:
+  void output(const hw::Vec3&) override {}
+
+ private:
+  const RecordedDeviceRows& rows_;
+  hw::DeviceLimits limits_;
+  std::string source_;
+  std::unique_ptr<hw::Trajectory> script_;
+  double time_ = 0.0;
+  bool overrun_ = false;
+};
+
+// The `mapping` attribute run.cpp writes: "identity ..." or "scale S; offset X Y Z m; rotation R P Y rad"
+// with every number at 17 significant digits, so it parses back to the same doubles.
+bool parse_mapping(const std::string& text, hw::WorkspaceMapping& m) {
+  if (text.rfind("identity", 0) == 0) return false;
+  double v[7];
+  if (std::sscanf(text.c_str(), "scale %lf; offset %lf %lf %lf m; rotation %lf %lf %lf rad", &v[0], &v[1], &v[2], &v[3],
+                  &v[4], &v[5], &v[6]) != 7)
+    throw ReplayError("mapping attribute '" + text + "' cannot be read");
+  m.scale = v[0];
+  m.offset = {v[1], v[2], v[3]};
+  m.rotation = {v[4], v[5], v[6]};
+  return true;
+}
+
+RecordedDeviceRows read_device_rows(const std::string& trace, const std::string& table) {
+  RecordedDeviceRows r;
+  r.position = read_vec3(trace, table + "/position");
+  r.gimbal = read_vec3(trace, table + "/gimbal");
+  const recordings::Dataset buttons = recordings::read_dataset(trace, table + "/buttons");
+  const recordings::Dataset time = recordings::read_dataset(trace, table + "/device_time");
+  const recordings::Dataset overrun = recordings::read_dataset(trace, table + "/overrun");
+  const recordings::Dataset ticks = recordings::read_dataset(trace, table + "/tick");
+  const std::size_t n = r.position.size();
+  if (r.gimbal.size() != n || buttons.values.size() != n || time.values.size() != n || overrun.values.size() != n)
+    throw ReplayError(trace + ": " + table + ": columns of different lengths");
+  for (std::size_t i = 0; i < n; ++i) {
+    if (ticks.values[i] != static_cast<double>(i))
+      throw ReplayError(trace + ": " + table + "/tick: row " + std::to_string(i) + " is not tick " + std::to_string(i));
+    r.buttons.push_back(static_cast<std::uint32_t>(buttons.values[i]));
+    r.overrun.push_back(overrun.values[i] != 0.0);
+  }
+  r.device_time = time.values;
+  r.mapped = parse_mapping(recordings::read_string_attribute(trace, table, "mapping"), r.mapping);
+  r.limits.max_force = std::strtod(recordings::read_string_attribute(trace, table, "max_force").c_str(), nullptr);
+  return r;
+}
+
 std::string required_string(const std::string& trace, const std::string& name) {
   if (!recordings::has_attribute(trace, "/", name)) {
     throw ReplayError(trace + ": root attribute '" + name + "' is missing: the trace cannot be replayed");
@@ -71,6 +149,9 @@ ReplayPlan load(const std::string& trace, const ReplayOptions& options) {
                       std::to_string(recordings::kSchemaVersion) + ")");
   }
   plan.status = required_string(trace, "status");
+  // The run's force ramp (0 in traces from before it was recorded): rendered forces again.
+  if (recordings::has_attribute(trace, "/", "force_ramp"))
+    plan.force_ramp = recordings::read_double_attribute(trace, "/", "force_ramp");
   plan.scenario_path = required_string(trace, "scenario_path");
   plan.scenario_source_hash = required_string(trace, "scenario_source_hash");
   const std::string source = required_string(trace, "scenario_source");
@@ -123,8 +204,12 @@ ReplayPlan load(const std::string& trace, const ReplayOptions& options) {
       throw ReplayError(trace + ": the scenario's finger '" + name + "' has no recorded inputs (" + p +
                         "hip and gimbal); fingers in the trace: " + recorded_fingers(trace));
     }
-    RecordedFinger r{read_vec3(trace, p + "hip"), read_vec3(trace, p + "gimbal")};
+    RecordedFinger r{read_vec3(trace, p + "hip"), read_vec3(trace, p + "gimbal"), std::nullopt};
     rows = std::min({rows, static_cast<std::int64_t>(r.hip.size()), static_cast<std::int64_t>(r.gimbal.size())});
+    if (recordings::has_object(trace, "/devices/" + name)) {
+      r.device = read_device_rows(trace, "/devices/" + name);
+      rows = std::min(rows, static_cast<std::int64_t>(r.device->position.size()));
+    }
     plan.fingers.push_back(std::move(r));
   }
   for (std::int64_t n = 0; n < rows; ++n) {
@@ -137,6 +222,16 @@ ReplayPlan load(const std::string& trace, const ReplayOptions& options) {
   for (RecordedFinger& r : plan.fingers) {
     r.hip.resize(static_cast<std::size_t>(rows));
     r.gimbal.resize(static_cast<std::size_t>(rows));
+  }
+  // A device session's mapping must still be the scenario's (the same source and overrides
+  // give the same mapping; a --set of it is a what-if that moves the hand).
+  for (std::size_t f = 0; f < plan.fingers.size(); ++f) {
+    const auto& d = plan.fingers[f].device;
+    const hw::WorkspaceMapping& m = plan.scenario->fingers()[f].mapping;
+    if (d && d->mapped && !plan.what_if &&
+        (d->mapping.scale != m.scale || d->mapping.offset != m.offset || d->mapping.rotation != m.rotation))
+      throw ReplayError(trace + ": /devices/" + model.fingers[f].name +
+                        ": the recorded workspace mapping is not the scenario's");
   }
   plan.recorded_ticks = rows;
   plan.scenario_ticks = static_cast<std::int64_t>(std::llround(plan.scenario->duration() * model.rates.servo));
@@ -155,6 +250,40 @@ ReplayPlan load(const std::string& trace, const ReplayOptions& options) {
 
 }  // namespace
 
+RecordedFinger read_recorded_finger(const std::string& trace, const std::string& finger, int rate_servo) {
+  try {
+    std::error_code ec;
+    if (!std::filesystem::is_regular_file(trace, ec)) throw ReplayError(trace + ": no such file");
+    if (!recordings::has_attribute(trace, "/", "schema_version"))
+      throw ReplayError(trace + ": not a graspsim trace (no root attribute 'schema_version')");
+    const std::int64_t schema = recordings::read_int_attribute(trace, "/", "schema_version");
+    if (schema < 2 || schema > recordings::kSchemaVersion)
+      throw ReplayError(trace + ": schema_version " + std::to_string(schema) + " cannot be replayed (this graspsim reads 2 to " +
+                        std::to_string(recordings::kSchemaVersion) + ")");
+    const std::int64_t recorded_rate = recordings::read_int_attribute(trace, "/", "rate_servo");
+    if (recorded_rate != rate_servo)
+      throw ReplayError(trace + ": recorded at rate_servo = " + std::to_string(recorded_rate) + " Hz, but this run's servo rate is " +
+                        std::to_string(rate_servo) + " Hz: the samples are one per recorded servo tick");
+    const std::string p = "/servo/fingers/" + finger + "/";
+    if (!recordings::has_object(trace, p + "hip") || !recordings::has_object(trace, p + "gimbal"))
+      throw ReplayError(trace + ": no recorded inputs of finger '" + finger + "' (" + p + "hip and gimbal); fingers in the trace: " +
+                        recorded_fingers(trace));
+    RecordedFinger r{read_vec3(trace, p + "hip"), read_vec3(trace, p + "gimbal"), std::nullopt};
+    const recordings::Dataset ticks = recordings::read_dataset(trace, "/servo/tick");
+    const std::size_t rows = std::min({ticks.values.size(), r.hip.size(), r.gimbal.size()});
+    for (std::size_t n = 0; n < rows; ++n) {
+      if (ticks.values[n] != static_cast<double>(n))
+        throw ReplayError(trace + ": /servo/tick: row " + std::to_string(n) + " is not tick " + std::to_string(n) +
+                          ": a replay needs every servo tick from 0 (is this a decimated trace?)");
+    }
+    r.hip.resize(rows);
+    r.gimbal.resize(rows);
+    return r;
+  } catch (const recordings::TraceError& e) {
+    throw ReplayError(e.what());
+  }
+}
+
 std::string ReplayPlan::replay_of() const { return trace + "\n" + scenario_source_hash; }
 
 RunOptions ReplayPlan::run_options(const std::string& out) const {
@@ -162,8 +291,18 @@ RunOptions ReplayPlan::run_options(const std::string& out) const {
   options.out = out;
   options.overrides = overrides;
   options.max_ticks = recorded_ticks;
+  options.force_ramp = force_ramp;
   options.attributes.emplace_back("replay_of", replay_of());
+  for (const RecordedFinger& r : fingers) options.record_devices.push_back(r.device.has_value());
   options.make_device = [this](std::size_t f) -> std::unique_ptr<hw::Device> {
+    const std::string& name = scenario->model().fingers[f].name;
+    if (const auto& d = fingers[f].device) {
+      // The device's own samples through the recorded mapping: the same world hip, bit for bit.
+      std::unique_ptr<hw::Device> rows = std::make_unique<DeviceRowsReplay>(
+          *d, d->limits, trace + " /devices/" + name, scenario->make_trajectory(f));
+      if (!d->mapped) return rows;
+      return std::make_unique<hw::MappedDevice>(std::move(rows), d->mapping);
+    }
     return std::make_unique<hw::ReplayDevice>(fingers[f].hip, fingers[f].gimbal, scenario->fingers()[f].limits,
                                               trace + " /servo/fingers/" + scenario->model().fingers[f].name,
                                               scenario->make_trajectory(f));

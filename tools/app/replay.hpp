@@ -6,12 +6,14 @@
 
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
 #include "app/run.hpp"
 #include "graspsim/hw/device.hpp"
+#include "graspsim/hw/mapped_device.hpp"
 #include "graspsim/scripting/scenario.hpp"
 
 namespace graspsim::app {
@@ -32,10 +34,26 @@ struct ReplayOptions {
   std::string scenario_dir;
 };
 
+// One finger's recorded device samples (/devices/<finger>), one element per servo tick: what
+// its device gave, in the device's frame, with the workspace mapping the run applied.
+struct RecordedDeviceRows {
+  std::vector<hw::Vec3> position;        // m, device frame
+  std::vector<hw::Vec3> gimbal;          // rad
+  std::vector<std::uint32_t> buttons;    // bit i: button i
+  std::vector<double> device_time;       // s, the device's clock
+  std::vector<bool> overrun;             // the recorded run's pacing
+  bool mapped = false;                   // the run mapped the samples (else device frame = world)
+  hw::WorkspaceMapping mapping;          // parsed back exactly from the table's `mapping`
+  hw::DeviceLimits limits;               // the device's, from the table's `max_force`
+};
+
 // One finger's recorded inputs, one element per servo tick.
 struct RecordedFinger {
   std::vector<hw::Vec3> hip;      // m, world
   std::vector<hw::Vec3> gimbal;   // rad (roll, pitch, yaw)
+  // Present when the trace has /devices/<finger>: the replay then feeds the device samples
+  // through the same mapping (the same world hip, bit for bit) and rewrites the same table.
+  std::optional<RecordedDeviceRows> device;
 };
 
 struct ReplayPlan {
@@ -49,6 +67,7 @@ struct ReplayPlan {
   std::int64_t recorded_ticks = 0;        // servo ticks with a sample for every finger
   std::int64_t scenario_ticks = 0;        // duration * rate_servo of the (overridden) scenario
   bool what_if = false;                   // ReplayOptions::sets was not empty
+  double force_ramp = 0.0;                // s: the recorded run's force ramp (root `force_ramp`)
   std::vector<std::string> notes;         // e.g. a cut trace replayed up to its last tick
   // The root attribute a replay trace carries: "<trace as given>\n<its scenario_source_hash>".
   std::string replay_of() const;
@@ -56,6 +75,13 @@ struct ReplayPlan {
   // The plan must outlive the run.
   RunOptions run_options(const std::string& out) const;
 };
+
+// One finger's recorded inputs from `trace` (/servo/fingers/<finger>/hip and gimbal), row n =
+// servo tick n, for a single finger replayed in another run (`--device FINGER=replay:TRACE`):
+// the trace must be a graspsim trace of schema >= 2 recorded at `rate_servo` Hz with every
+// servo tick from 0. Throws ReplayError naming the file and what is wrong (the fingers it holds
+// when `finger` is not one of them).
+RecordedFinger read_recorded_finger(const std::string& trace, const std::string& finger, int rate_servo);
 
 // Reads the trace's scenario and device samples and checks that they can be replayed.
 // Throws ReplayError (bad input) with the file and the dataset, attribute or field named.

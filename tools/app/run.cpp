@@ -14,6 +14,8 @@
 
 #include "graspsim/engine/simulation.hpp"
 #include "graspsim/engine/state_hash.hpp"
+#include "graspsim/hw/mapped_device.hpp"
+#include "graspsim/hw/sample_clock.hpp"
 #include "graspsim/hw/scripted_finger.hpp"
 #include "graspsim/recordings/trace_recorder.hpp"
 #include "graspsim/recordings/trace_writer.hpp"
@@ -118,6 +120,44 @@ std::int64_t flush_interval_ticks(const Model& model) {
   return period <= limit ? limit / period * period : limit;
 }
 
+// One finger's /devices/<finger> table (recordings/README.md "Schema"): every device sample as
+// the device gave it, in its own frame, with the force sent to it in that frame.
+struct DeviceColumns {
+  std::size_t finger;   // Model::fingers index
+  recordings::TraceTable* table;
+  std::size_t tick, time, device_time, position, gimbal, buttons, force, overrun;   // row offsets
+};
+
+std::string mapping_text(const hw::WorkspaceMapping& m) {
+  char buf[256];
+  std::snprintf(buf, sizeof buf, "scale %.17g; offset %.17g %.17g %.17g m; rotation %.17g %.17g %.17g rad", m.scale,
+                m.offset.x(), m.offset.y(), m.offset.z(), m.rotation.x(), m.rotation.y(), m.rotation.z());
+  return buf;
+}
+
+DeviceColumns device_columns(recordings::TraceWriter& writer, std::size_t finger, const std::string& name,
+                             const hw::Device& device, std::size_t block_rows) {
+  using recordings::DType;
+  DeviceColumns c{finger, &writer.table("devices/" + name, block_rows), 0, 0, 0, 0, 0, 0, 0, 0};
+  recordings::TraceTable& t = *c.table;
+  c.tick = t.add_column("tick", 1, DType::kInt64, "tick");
+  c.time = t.add_column("time", 1, DType::kFloat64, "s");
+  c.device_time = t.add_column("device_time", 1, DType::kFloat64, "s");
+  c.position = t.add_column("position", 3, DType::kFloat64, "m");
+  c.gimbal = t.add_column("gimbal", 3, DType::kFloat64, "rad");
+  c.buttons = t.add_column("buttons", 1, DType::kInt64, "1");
+  c.force = t.add_column("force", 3, DType::kFloat64, "N");
+  c.overrun = t.add_column("overrun", 1, DType::kInt8, "1");
+  t.set_attribute(".", "device", device.describe());
+  const auto* mapped = dynamic_cast<const hw::MappedDevice*>(&device);
+  t.set_attribute(".", "mapping", mapped ? mapping_text(mapped->mapping()) : "identity (device frame = world)");
+  t.set_attribute("gimbal", "order", "roll, pitch, yaw");
+  char limit[32];
+  std::snprintf(limit, sizeof limit, "%.17g", device.limits().max_force);
+  t.set_attribute(".", "max_force", limit);   // N: the clamp the run used (a replay uses it again)
+  return c;
+}
+
 }  // namespace
 
 bool RunResult::passed() const {
@@ -162,16 +202,27 @@ RunResult run_scenario(const scripting::Scenario& scenario, const RunOptions& op
 
   std::vector<std::unique_ptr<hw::Device>> devices;
   std::vector<double> slip(model.fingers.size(), 0.0);
-  const auto release_all = [&devices] {
-    for (auto& d : devices) d->release();
+  // Zero force on every device, even if one of them fails to take it (its error is kept for
+  // the result when the run has none: a device that may still push is worth reporting).
+  std::string release_error;
+  const auto release_all = [&devices, &release_error] {
+    for (auto& d : devices) {
+      try {
+        d->release();
+      } catch (const std::exception& e) {
+        if (release_error.empty()) release_error = "releasing " + d->describe() + ": " + e.what();
+      }
+    }
   };
   result.warnings = stability_warnings(model);
   std::string warnings;
   for (const std::string& w : result.warnings) warnings += w + "\n";
   writer.set_attribute("warnings", warnings);
+  writer.set_attribute("force_ramp", options.force_ramp);
 
   const auto start = Clock::now();
   std::optional<Simulation> sim_holder;
+  bool realtime = false;   // this thread is SCHED_FIFO (until the loop ends)
   try {
     std::ostringstream device_list;
     for (std::size_t f = 0; f < model.fingers.size(); ++f) {
@@ -182,11 +233,19 @@ RunResult run_scenario(const scripting::Scenario& scenario, const RunOptions& op
                   << " (max force " << devices.back()->limits().max_force << " N)\n";
     }
     writer.set_attribute("devices", device_list.str());
+    std::vector<hw::DeviceSample> samples(devices.size());   // this tick's, as read (world)
 
     Simulation& sim = sim_holder.emplace(model);
     std::optional<recordings::TraceRecorder> recorder;
     const std::int64_t flush_ticks = flush_interval_ticks(model);
     if (writer_holder) recorder.emplace(*writer_holder, model, options.block_rows > 0 ? 0 : flush_ticks);
+    std::vector<DeviceColumns> device_tables;
+    if (writer_holder) {
+      for (std::size_t f = 0; f < options.record_devices.size() && f < devices.size(); ++f)
+        if (options.record_devices[f])
+          device_tables.push_back(device_columns(*writer_holder, f, model.fingers[f].name, *devices[f],
+                                                 options.block_rows > 0 ? options.block_rows : flush_ticks));
+    }
     Input input = make_input(model);
     TickRecord record = make_tick_record(model);
     std::vector<Vec3> rendered(model.fingers.size(), Vec3::Zero());
@@ -224,12 +283,18 @@ RunResult run_scenario(const scripting::Scenario& scenario, const RunOptions& op
 
     auto last_progress = start;
     auto last_flush = start;
+    if (options.pacer) {
+      // The writer thread exists already (the TraceWriter started it), so only this thread
+      // becomes real-time; the CLI has warned if the system does not allow it.
+      if (options.realtime) realtime = enter_realtime().empty();
+      options.pacer->start();
+    }
     for (std::int64_t n = 0; n < run_ticks; ++n) {
       const double t = sim.time();
       for (std::size_t f = 0; f < devices.size(); ++f) {
-        const hw::DeviceSample sample = devices[f]->read(n, t);
-        input.fingers[f].hip = sample.position;
-        input.fingers[f].gimbal = sample.gimbal;
+        samples[f] = devices[f]->read(n, t);
+        input.fingers[f].hip = samples[f].position;
+        input.fingers[f].gimbal = samples[f].gimbal;
       }
       if (n == 0) {
         // Before the first step no finger record exists yet: a finger is where its device is.
@@ -238,7 +303,49 @@ RunResult run_scenario(const scripting::Scenario& scenario, const RunOptions& op
       }
       check_due(n);
       sim.step(input, record);
-      for (std::size_t f = 0; f < devices.size(); ++f) rendered[f] = devices[f]->render(record.servo[f].force);
+      if (options.force_ramp > 0.0 && t < options.force_ramp) {
+        const double ramp = t / options.force_ramp;   // 1: linear rise from 0 at t = 0
+        for (std::size_t f = 0; f < devices.size(); ++f) rendered[f] = devices[f]->render(ramp * record.servo[f].force);
+      } else {
+        for (std::size_t f = 0; f < devices.size(); ++f) rendered[f] = devices[f]->render(record.servo[f].force);
+      }
+      TickPace pace;
+      if (options.pacer) {
+        // The forces are out: wait for this tick's deadline (or count it late). A stall releases
+        // every device at once, before anything else runs, and ends the run.
+        pace = options.pacer->end_tick(n);
+        if (pace.stalled) {
+          release_all();
+          throw std::runtime_error("the servo loop stalled: tick " + std::to_string(n) + " ended " +
+                                   std::to_string(pace.lateness * 1e3) + " ms past its deadline (timeout " +
+                                   std::to_string(options.pacer->stall_timeout() * 1e3) +
+                                   " ms); every device was released");
+        }
+      }
+      for (const DeviceColumns& c : device_tables) {
+        // The device's own view: before the mapping (device frame) and the force it was sent.
+        hw::Device* d = devices[c.finger].get();
+        const hw::DeviceSample* raw = &samples[c.finger];
+        const hw::Vec3* force = &rendered[c.finger];
+        if (auto* mapped = dynamic_cast<hw::MappedDevice*>(d)) {
+          raw = &mapped->last_device_sample();
+          force = &mapped->last_device_force();
+          d = &mapped->inner();
+        }
+        const auto* clock = dynamic_cast<const hw::SampleClock*>(d);
+        const auto* recorded = dynamic_cast<const RecordedPacing*>(d);
+        double* row = c.table->append_row();
+        row[c.tick] = static_cast<double>(n);
+        row[c.time] = static_cast<double>(n) / model.rates.servo;
+        row[c.device_time] = clock ? clock->sample_time() : t;
+        for (int i = 0; i < 3; ++i) {
+          row[c.position + i] = raw->position[i];
+          row[c.gimbal + i] = raw->gimbal[i];
+          row[c.force + i] = (*force)[i];
+        }
+        row[c.buttons] = static_cast<double>(raw->buttons);
+        row[c.overrun] = (recorded ? recorded->recorded_overrun() : pace.overrun) ? 1.0 : 0.0;
+      }
       if (recorder) {
         recorder->record(record, rendered, input, sim.state());
         if ((n + 1) % flush_ticks == 0 ||
@@ -268,6 +375,11 @@ RunResult run_scenario(const scripting::Scenario& scenario, const RunOptions& op
         fill_snapshot(sim, record, slip, view_state);
         scenario.update_view(view_state);
       }
+      // Paced (a hand on a device): Ctrl-C is seen at the next tick, not up to a second later.
+      if (options.pacer && options.interrupt && options.interrupt->load()) {
+        result.interrupted = true;
+        throw std::runtime_error("interrupted at t = " + std::to_string(sim.time()) + " s");
+      }
       // Wall-clock checks only every 3000 ticks: they are the only clock reads in the loop.
       if (n % 3000 == 2999) {
         if (options.interrupt && options.interrupt->load()) {
@@ -275,7 +387,7 @@ RunResult run_scenario(const scripting::Scenario& scenario, const RunOptions& op
           throw std::runtime_error("interrupted at t = " + std::to_string(sim.time()) + " s");
         }
         // The first progress line after 2 s: a quick run prints none.
-        if (options.progress && seconds_since(start) > 2.0 && seconds_since(last_progress) > 0.25) {
+        if (options.progress && !options.pacer && seconds_since(start) > 2.0 && seconds_since(last_progress) > 0.25) {
           last_progress = Clock::now();
           options.progress(sim.time(), scenario.duration());
         }
@@ -287,7 +399,13 @@ RunResult run_scenario(const scripting::Scenario& scenario, const RunOptions& op
     result.error = e.what();
   }
   if (sim_holder) result.simulated = sim_holder->time();
-  release_all();
+  release_all();   // at the end, on error, on interrupt: no device keeps a force
+  if (result.error.empty() && !release_error.empty()) result.error = release_error;
+  if (realtime) leave_realtime();
+  if (options.pacer) {
+    result.pacing = options.pacer->summary();
+    result.overruns = options.pacer->overruns();
+  }
   result.wall = seconds_since(start);
 
   std::ostringstream summary;

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "app/pacer.hpp"
 #include "graspsim/hw/device.hpp"
 #include "graspsim/scripting/scenario.hpp"
 
@@ -37,6 +38,29 @@ struct RunOptions {
   std::function<std::unique_ptr<hw::Device>(std::size_t finger)> make_device;
   std::int64_t max_ticks = -1;
   std::vector<std::pair<std::string, std::string>> attributes;
+  // Devices (README.md "Devices"): fingers whose every device sample goes to /devices/<finger>
+  // (empty: none; the fingers of non-scripted devices, DevicePlan::recorded()).
+  std::vector<bool> record_devices;
+  // Real-time pacing (tools/app/pacer.hpp), with a real device attached: null runs as fast as
+  // possible. With a pacer the loop prints nothing (no progress callback) and checks the
+  // interrupt at every tick; a stall releases every device and stops the run. `realtime`: the
+  // loop's thread asks for SCHED_FIFO while it runs (after the trace writer's thread started, so
+  // that thread stays an ordinary one).
+  Pacer* pacer = nullptr;
+  bool realtime = false;
+  // Force ramp (s, 0: none): every rendered force is scaled by min(1, t / force_ramp) from the
+  // start, so a hand that starts inside an object is not kicked (graspsim run: kForceRamp with a
+  // real device). Only what devices render changes, never the engine; root attribute
+  // `force_ramp`, which a replay applies again.
+  double force_ramp = 0.0;
+};
+
+// A device whose samples carry their recorded overrun flag (a replay of /devices rows): the
+// run loop records that flag instead of its own pacing's, so a replay rewrites the same rows.
+class RecordedPacing {
+ public:
+  virtual ~RecordedPacing() = default;
+  virtual bool recorded_overrun() const = 0;   // of the last sample read
 };
 
 struct RunResult {
@@ -48,6 +72,8 @@ struct RunResult {
   double wall = 0.0;        // s
   std::string error;        // non-empty when the run stopped early (Lua error, interrupt, ...)
   bool interrupted = false;
+  std::string pacing;        // with a pacer: its summary (overruns of how many ticks, worst lateness)
+  std::int64_t overruns = 0; // with a pacer: servo ticks that missed their deadline
   bool passed() const;      // no error and every expectation met
 };
 

@@ -12,6 +12,8 @@
 #include <vector>
 
 #include "app/compare.hpp"
+#include "app/devices.hpp"
+#include "app/pacer.hpp"
 #include "app/run.hpp"
 #include "cli/repair.hpp"
 #include "cli/replay.hpp"
@@ -31,6 +33,7 @@ using graspsim::cli::kExitOk;
 
 constexpr const char* kUsage =
     "usage: graspsim run SCENARIO.lua [--out FILE.h5] [--duration S] [--set NAME=VALUE]...\n"
+    "                [--device FINGER=SPEC]...\n"
     "       graspsim replay TRACE.h5 [--out NEW.h5] [--set NAME=VALUE]...\n"
     "       graspsim repair TRACE.h5\n"
     "       graspsim compare A.h5 B.h5 [--atol X] [--rtol X] [--tol PATTERN=ATOL[,RTOL]]...\n"
@@ -53,6 +56,11 @@ constexpr const char* kHelp =
     "  --set NAME=VALUE     override a scenario value, e.g. --set rates.physics=500,\n"
     "                       --set objects.box.mass=0.5, --set fingers.thumb.stiffness=600,\n"
     "                       --set gravity=0,0,-1.62, or a param() the scenario declares\n"
+    "  --device FINGER=SPEC drive FINGER by SPEC instead of the scenario's default device\n"
+    "                       (repeatable): scripted, replay:TRACE.h5 (that finger's recorded\n"
+    "                       hip and gimbal), sim-phantom[:MODEL], udp:HOST:PORT, phantom:NAME.\n"
+    "                       With udp or phantom the run is paced in real time at the servo\n"
+    "                       rate; every non-scripted device's samples go to /devices/FINGER\n"
     "  --compress N         deflate the trace at level N (1..9; default none)\n"
     "  --quiet              print only errors and failed expectations\n"
     "  -h, --help           this help\n"
@@ -155,6 +163,7 @@ int run_command(const std::vector<std::string>& args) {
   graspsim::scripting::LoadOptions load;
   int compression = 0;
   bool quiet = false;
+  std::vector<std::string> device_options;
   for (std::size_t i = 0; i < args.size(); ++i) {
     const std::string& a = args[i];
     const auto value = [&]() -> const std::string* {
@@ -164,6 +173,11 @@ int run_command(const std::vector<std::string>& args) {
     if (a == "-h" || a == "--help") {
       std::cout << kHelp;
       return kExitOk;
+    } else if (a == "--device") {
+      const std::string* v = value();
+      if (!v || v->empty() || v->front() == '-')
+        return bad_input("--device needs FINGER=SPEC" + (v ? " (got '" + *v + "')" : std::string()));
+      device_options.push_back(*v);
     } else if (a == "--out") {
       const std::string* v = value();
       if (!v || v->empty() || v->front() == '-')
@@ -205,12 +219,37 @@ int run_command(const std::vector<std::string>& args) {
     return bad_input(e.what());
   }
 
+  // Each finger's device: the scenario's default, then --device; bad specs exit 2 before any
+  // device opens or any trace is written.
+  const graspsim::app::DeviceRegistry registry = graspsim::app::default_registry();
+  graspsim::app::DevicePlan plan;
+  try {
+    plan = graspsim::app::plan_devices(*scenario, device_options, registry);
+  } catch (const graspsim::app::DeviceError& e) {
+    return bad_input(e.what());
+  }
+
   graspsim::app::RunOptions options;
   options.out = out;
   options.compression = compression;
   options.overrides = load.sets;
   options.interrupt = &g_interrupt;
-  const bool tty = isatty(STDERR_FILENO) && !quiet;
+  options.record_devices = plan.recorded();
+  // Devices are built when the run starts (run_scenario), so that every one built is released
+  // however the run ends; a device that cannot be built ends the run with its error (exit 2).
+  options.make_device = [&](std::size_t f) { return graspsim::app::make_device(plan, registry, *scenario, f); };
+  // A hand on a real device: pace the loop in real time on a SCHED_FIFO thread if allowed.
+  graspsim::app::SteadyClock steady;
+  std::optional<graspsim::app::Pacer> pacer;
+  if (plan.any_real()) {
+    pacer.emplace(steady, scenario->model().rates.servo, graspsim::app::kStallTimeout);
+    options.pacer = &*pacer;
+    options.force_ramp = graspsim::app::kForceRamp;
+    const std::string why = graspsim::app::probe_realtime();
+    options.realtime = why.empty();
+    if (!why.empty()) std::cerr << "graspsim: warning: " << why << "\n";
+  }
+  const bool tty = isatty(STDERR_FILENO) && !quiet && !pacer;
   if (tty) {
     options.progress = [](double t, double duration) {
       std::fprintf(stderr, "\r  running: %5.1f%%  t = %.2f of %.2f s", 100.0 * t / duration, t, duration);
@@ -242,6 +281,7 @@ int run_command(const std::vector<std::string>& args) {
     std::printf("  wall time   %.3g s (%.0fx real time)\n", result.wall,
                 result.wall > 0 ? result.simulated / result.wall : 0.0);
     std::printf("  trace       %s (%s)\n", result.trace_path.c_str(), ec ? "?" : human_bytes(size).c_str());
+    if (pacer) std::printf("  pacing      %s%s\n", result.pacing.c_str(), options.realtime ? ", SCHED_FIFO" : "");
   }
   if (!result.error.empty()) {
     std::fprintf(stderr, "graspsim: the run stopped early: %s\n  (the trace keeps every tick up to there)\n",

@@ -12,6 +12,7 @@
 #include "graspsim/engine/model.hpp"
 #include "graspsim/engine/state.hpp"
 #include "graspsim/hw/device.hpp"
+#include "graspsim/hw/mapped_device.hpp"
 #include "graspsim/hw/trajectory.hpp"
 #include "graspsim/scripting/error.hpp"        // ScenarioError
 #include "graspsim/scripting/lua_sandbox.hpp"  // SandboxLimits
@@ -23,6 +24,12 @@ class LuaSandbox;
 // What a finger is driven by when nothing on the command line overrides it.
 struct FingerSetup {
   hw::DeviceLimits limits;   // clamp for rendered forces
+  // `device = { default = SPEC, scale, offset, rotation }`: the finger's device when the command
+  // line names none (a --device SPEC, tools/app/devices.hpp; "scripted" unless given) and the
+  // mapping of that device's workspace into the world (not applied to scripted fingers, whose
+  // trajectories are already in the world).
+  std::string device = "scripted";
+  hw::WorkspaceMapping mapping;
 };
 
 // One expectation about the outcome: a Lua function checked at time `at`.

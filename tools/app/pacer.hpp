@@ -1,0 +1,76 @@
+// Real-time pacing of the lockstep loop (issue 6, item 5): with a real device attached, servo
+// tick n must finish by start + (n + 1) / rate on a monotonic clock. The pacer sleeps until that
+// deadline, counts the ticks that miss it (overruns), and reports a stall (a tick that ends more
+// than `stall_timeout` past its deadline) so that the run loop releases every device. The clock
+// is injected: tests drive a fake one (no wall-clock thresholds), runs use SteadyClock.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+namespace graspsim::app {
+
+// The stall timeout of graspsim run (s): longer than a scheduling hiccup of a kernel without
+// PREEMPT_RT (a few ms), well under the ~100 ms a hand needs to react, so nobody feels a stale
+// force for longer than that before every device is released.
+inline constexpr double kStallTimeout = 0.02;
+
+// The force ramp of graspsim run with a real device (s, RunOptions::force_ramp): rendered
+// forces rise linearly from 0 over the first half second, slower than a hand's reflex, so a
+// device that starts inside an object (or a wrong mapping) pushes gently before it pushes fully.
+inline constexpr double kForceRamp = 0.5;
+
+class MonotonicClock {
+ public:
+  virtual ~MonotonicClock() = default;
+  virtual std::int64_t now_ns() = 0;                     // ns, monotonic, arbitrary origin
+  virtual void sleep_until_ns(std::int64_t deadline) = 0;   // returns at or after `deadline`
+};
+
+// CLOCK_MONOTONIC, absolute clock_nanosleep (no drift from summed relative sleeps).
+class SteadyClock final : public MonotonicClock {
+ public:
+  std::int64_t now_ns() override;
+  void sleep_until_ns(std::int64_t deadline) override;
+};
+
+struct TickPace {
+  bool overrun = false;        // the tick's work ended after its deadline
+  bool stalled = false;        // ... by more than the stall timeout
+  double lateness = 0.0;       // s: how far past the deadline (0 when on time)
+};
+
+class Pacer {
+ public:
+  // rate: servo ticks per second (> 0); stall_timeout (s, > 0): lateness that counts as a stall.
+  Pacer(MonotonicClock& clock, int rate, double stall_timeout);
+  void start();                        // tick 0's period begins now
+  // After tick n's work: returns how it kept its deadline start + (n + 1) / rate, and sleeps
+  // until that deadline when early. Deadlines stay on the absolute schedule (a late tick is made
+  // up by the following ones when they are quicker), so simulated time keeps pace with the
+  // hand's time instead of drifting behind it after every overrun.
+  TickPace end_tick(std::int64_t n);
+  std::int64_t overruns() const { return overruns_; }
+  std::int64_t ticks() const { return ticks_; }
+  double worst_lateness() const { return worst_; }   // s
+  double stall_timeout() const { return static_cast<double>(stall_ns_) * 1e-9; }   // s
+  std::string summary() const;   // "N of M ticks overran (worst X ms late)"
+
+ private:
+  MonotonicClock& clock_;
+  std::int64_t rate_;        // Hz
+  std::int64_t start_ns_ = 0;
+  std::int64_t stall_ns_;    // ns
+  std::int64_t overruns_ = 0, ticks_ = 0;
+  double worst_ = 0.0;       // s
+};
+
+// Real-time scheduling of the calling thread (SCHED_FIFO at a middle priority), where the system
+// allows it. Returns "" on success, else a one-line reason (for the warning); leave_realtime
+// returns the thread to SCHED_OTHER.
+std::string enter_realtime();
+void leave_realtime();
+// Whether enter_realtime() would succeed, without staying real-time ("" yes, else why not).
+std::string probe_realtime();
+
+}  // namespace graspsim::app
