@@ -120,9 +120,13 @@ TEST_CASE("Device specs: defaults, overrides and errors that name the finger, th
   CHECK_THAT(plan({"thumb=replay"}), Catch::Contains("device 'replay' needs an argument: replay:TRACE.h5"));
   CHECK_THAT(plan({"thumb=scripted:x"}), Catch::Contains("takes no argument"));
   CHECK_THAT(plan({"thumb=scripted", "thumb=replay:a.h5"}), Catch::Contains("'thumb' already has a --device"));
-  // Backends not built into this binary: a clear error before anything opens.
-  for (const std::string spec : {"udp:127.0.0.1:7001", "phantom:Default PHANToM", "sim-phantom", "sim-phantom:omni"})
-    CHECK_THAT(plan({"index=" + spec}), Catch::Contains("not built into this binary") && Catch::Contains("built: scripted, replay:TRACE.h5"));
+  // Every kind is built into this binary (phantom: a clear error at open without the SDK); a
+  // kind registered without a factory gives a clear error before anything opens.
+  app::DeviceRegistry partial = registry;
+  partial.add({"udp", "udp:HOST:PORT", true, true, nullptr});
+  CHECK_THAT(error_of([&] { app::plan_devices(scenario, {"index=udp:127.0.0.1:7001"}, partial); }),
+             Catch::Contains("not built into this binary") &&
+                 Catch::Contains("built: scripted, replay:TRACE.h5, sim-phantom[:MODEL], phantom:NAME"));
   // The scenario's own default is checked the same way, named by its field.
   const auto bad_default = lift_with_index_device("{ default = \"nope\" }");
   CHECK_THAT(error_of([&] { app::plan_devices(bad_default, {}, registry); }),
@@ -335,14 +339,17 @@ TEST_CASE("graspsim run --device: bad specs exit 2 before writing, a replayed fi
   r = graspsim::test::shell(cli + " run " + kLift + " --out " + out + " --device thumb=haptx");
   CHECK(r.status == 2);
   CHECK_THAT(r.output, Catch::Contains("unknown device kind 'haptx'"));
-  r = graspsim::test::shell(cli + " run " + kLift + " --out " + out + " --device 'index=udp:127.0.0.1:7001'");
-  CHECK(r.status == 2);
-  CHECK_THAT(r.output, Catch::Contains("not built into this binary"));
   r = graspsim::test::shell(cli + " run " + kLift + " --out " + out + " --device");
   CHECK(r.status == 2);
   CHECK_THAT(r.output, Catch::Contains("--device needs FINGER=SPEC"));
   std::ifstream none(out);
   CHECK_FALSE(none.good());   // nothing written
+  // A device that cannot open (here: no OpenHaptics in this build) is not a bad spec: exit 2
+  // with the reason, and the trace says the run stopped before its first tick.
+  const std::string unopened = kTmp + "/devices_cli_phantom.h5";
+  r = graspsim::test::shell(cli + " run " + kLift + " --out " + unopened + " --device 'index=phantom:Default PHANToM'");
+  CHECK(r.status == 2);
+  CHECK_THAT(r.output, Catch::Contains("OpenHaptics") && Catch::Contains("Default PHANToM"));
 
   const std::string first = kTmp + "/devices_cli_first.h5";
   REQUIRE(graspsim::test::shell(cli + " run " + kLift + " --quiet --out " + first).status == 0);
@@ -422,4 +429,22 @@ TEST_CASE("The force ramp scales rendered forces by t / ramp, leaves the engine 
   recordings::CompareOptions bitwise;
   bitwise.bitwise = true;
   CHECK(recordings::compare_traces(ramped.out, kTmp + "/ramp_2s.replay.h5", bitwise).same());
+}
+
+// Every finger on the simulated Phantom (issue 6): the run is recorded with /devices/<finger>
+// (the device's own samples) and replays bit for bit. The stylus is held by a 300 N/m hand and
+// the Premium 1.5's force is derated to its continuous 1.4 N: the lift's expectations are the
+// scenario's business (here they fail: too weak a grip for a 0.2 kg box), the replay is ours.
+TEST_CASE("A run with every finger on sim-phantom records its samples and replays bit for bit", "[e2e][devices]") {
+  const std::string cli = GRASPSIM_CLI;
+  const std::string out = kTmp + "/devices_sim_phantom.h5";
+  const auto run = graspsim::test::shell(cli + " run " + kLift + " --quiet --duration 2 --out " + out +
+                                         " --device thumb=sim-phantom --device index=sim-phantom:omni");
+  INFO(run.output);
+  CHECK(run.status != 2);
+  CHECK_THAT(graspsim::recordings::read_string_attribute(out, "/devices/index", "device"), Catch::Contains("Omni"));
+  CHECK(graspsim::recordings::read_dataset(out, "/devices/thumb/position").shape.at(0) == 6000);
+  const auto replay = graspsim::test::shell(cli + " replay " + out + " --out " + kTmp + "/devices_sim_phantom_replay.h5");
+  INFO(replay.output);
+  CHECK_THAT(replay.output, Catch::Contains("reproduced  bit for bit"));
 }

@@ -6,6 +6,9 @@
 
 #include "app/replay.hpp"
 #include "graspsim/hw/mapped_device.hpp"
+#include "graspsim/hw/openhaptics_device.hpp"
+#include "graspsim/hw/sim_phantom.hpp"
+#include "graspsim/hw/udp_device.hpp"
 #include "graspsim/hw/replay_device.hpp"
 #include "graspsim/hw/scripted_finger.hpp"
 
@@ -46,6 +49,31 @@ std::unique_ptr<hw::Device> make_replay(const DeviceContext& c) {
                                             c.spec.arg + " /servo/fingers/" + name, c.scenario.make_trajectory(c.finger));
 }
 
+// A simulated Phantom (hw/sim_phantom.hpp) of model MODEL (default: the Premium 1.5 of the
+// paper), held by a scripted hand that follows the finger's trajectory in the device's frame.
+// Its workspace box is centred on where that hand starts (taken from a second instance of the
+// trajectory, so the hand's own is not advanced), so a scenario's motion fits the device
+// whatever its world coordinates; the force limits are the model's.
+std::unique_ptr<hw::Device> make_sim_phantom_device(const DeviceContext& c) {
+  hw::SimPhantomConfig config;
+  if (!c.spec.arg.empty()) config.model = c.spec.arg;
+  config.workspace_center = c.hand_in_device_frame()->position(0.0);
+  return hw::make_sim_phantom(config, c.hand_in_device_frame());
+}
+
+// A device served over UDP (hw/udp_device.hpp, hw/README.md "UDP protocol"); the finger's
+// force limit from the scenario is its clamp.
+std::unique_ptr<hw::Device> make_udp(const DeviceContext& c) {
+  hw::UdpDeviceConfig config = hw::parse_udp_spec(c.spec.arg);
+  config.limits = c.scenario.fingers()[c.finger].limits;
+  return hw::make_udp_device(config);
+}
+
+// A Phantom through OpenHaptics (hw/openhaptics_device.hpp), by its configured name.
+std::unique_ptr<hw::Device> make_phantom(const DeviceContext& c) {
+  return hw::make_openhaptics_device(c.spec.arg);
+}
+
 }  // namespace
 
 std::unique_ptr<hw::Trajectory> DeviceContext::hand_in_device_frame() const {
@@ -79,13 +107,11 @@ DeviceRegistry default_registry() {
   DeviceRegistry r;
   r.add({"scripted", "scripted", false, false, make_scripted});
   r.add({"replay", "replay:TRACE.h5", false, false, make_replay});
-  // Backends written in parallel (issue 6): registered at merge with their factories, e.g.
-  //   sim-phantom: make_sim_phantom(config for MODEL, context.hand_in_device_frame())
-  //   udp:         make_udp_device(parse_udp_spec(context.spec.arg))
-  //   phantom:     make_openhaptics_device(context.spec.arg)
-  r.add({"sim-phantom", "sim-phantom[:MODEL]", false, true, nullptr});
-  r.add({"udp", "udp:HOST:PORT", true, true, nullptr});
-  r.add({"phantom", "phantom:NAME", true, true, nullptr});
+  // A simulated device is not real (no hand on it): the run stays as fast as possible and
+  // deterministic. UDP and OpenHaptics devices are real: the run is paced.
+  r.add({"sim-phantom", "sim-phantom[:MODEL]", false, true, make_sim_phantom_device});
+  r.add({"udp", "udp:HOST:PORT", true, true, make_udp});
+  r.add({"phantom", "phantom:NAME", true, true, make_phantom});
   return r;
 }
 
