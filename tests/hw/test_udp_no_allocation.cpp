@@ -10,17 +10,9 @@
 #include "graspsim/hw/udp_device.hpp"
 #include "tests/hw/udp_peer.hpp"
 
-namespace {
-std::atomic<long> g_allocations{0};
-}
+#include "tests/support/count_allocations.hpp"
 
-void* operator new(std::size_t n) {
-  ++g_allocations;
-  if (void* p = std::malloc(n ? n : 1)) return p;
-  throw std::bad_alloc();
-}
-void operator delete(void* p) noexcept { std::free(p); }
-void operator delete(void* p, std::size_t) noexcept { std::free(p); }
+using graspsim::test::g_allocations;
 
 using namespace graspsim::hw;
 
