@@ -148,6 +148,27 @@ void write_scalar_attribute(hid_t object, const std::string& name, hid_t file_ty
   check(H5Awrite(attribute.get(), memory_type, value), where);
 }
 
+Member member_of(hid_t dataset, const std::string& name, const std::string& context) {
+  Handle row = checked(H5Dget_type(dataset), H5Tclose, context);
+  const int index = H5Tget_member_index(row.get(), name.c_str());
+  if (index < 0) throw TraceError(context + ": no member '" + name + "'");
+  const auto k = static_cast<unsigned>(index);
+  Member out;
+  Handle type = checked(H5Tget_member_type(row.get(), k), H5Tclose, context);
+  if (H5Tget_class(type.get()) == H5T_ARRAY) {
+    if (H5Tget_array_ndims(type.get()) != 1) throw TraceError(context + ": not a 1-D array member");
+    hsize_t dims[1] = {0};
+    check(H5Tget_array_dims2(type.get(), dims), context);
+    out.width = static_cast<std::size_t>(dims[0]);
+    out.element = checked(H5Tget_super(type.get()), H5Tclose, context);
+  } else {
+    out.element = std::move(type);
+  }
+  Handle native = checked(H5Tget_native_type(row.get(), H5T_DIR_ASCEND), H5Tclose, context);
+  out.native_offset = H5Tget_member_offset(native.get(), k);
+  return out;
+}
+
 std::vector<std::string> member_names(hid_t dataset, const std::string& context) {
   Handle type = checked(H5Dget_type(dataset), H5Tclose, context);
   std::vector<std::string> names;

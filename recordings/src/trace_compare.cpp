@@ -280,28 +280,11 @@ Column open_column(const OpenTrace& t, const std::string& group, const std::stri
     order_key = name + "/order";
     c.dataset = h5::checked(H5Dopen2(t.file.get(), group.c_str(), H5P_DEFAULT), H5Dclose,
                             context + ": cannot open");
-    h5::Handle row = h5::checked(H5Dget_type(c.dataset.get()), H5Tclose, context);
-    const int index = H5Tget_member_index(row.get(), name.c_str());
-    if (index < 0) fail(context + ": no such member");
-    h5::Handle member = h5::checked(H5Tget_member_type(row.get(), static_cast<unsigned>(index)),
-                                    H5Tclose, context);
-    {
-      // Where the member sits in the native row type the table's rows are read in.
-      h5::Handle native = h5::checked(H5Tget_native_type(row.get(), H5T_DIR_ASCEND), H5Tclose, context);
-      c.member_offset = H5Tget_member_offset(native.get(), static_cast<unsigned>(index));
-    }
-    if (H5Tget_class(member.get()) == H5T_ARRAY) {
-      if (H5Tget_array_ndims(member.get()) != 1) fail(context + ": not a 1-D array member");
-      hsize_t dims[1] = {0};
-      H5Tget_array_dims2(member.get(), dims);
-      c.width = static_cast<std::size_t>(dims[0]);
-      c.rank = 2;
-      type = h5::checked(H5Tget_super(member.get()), H5Tclose, context);
-    } else {
-      c.width = 1;
-      c.rank = 1;
-      type = std::move(member);
-    }
+    h5::Member member = h5::member_of(c.dataset.get(), name, context);
+    c.member_offset = member.native_offset;   // where it sits in the rows TableRows reads
+    c.width = member.width;
+    c.rank = member.width > 1 ? 2 : 1;
+    type = std::move(member.element);
     h5::Handle space = h5::checked(H5Dget_space(c.dataset.get()), H5Sclose, context);
     if (H5Sget_simple_extent_ndims(space.get()) != 1) fail(context + ": its table is not 1-D");
     hsize_t rows[1] = {0};
@@ -393,6 +376,7 @@ class BlockReader {
     return buffer_.data();
   }
 
+  // A schema 2 dataset's rows (a compound table's columns decode from its TableRows instead).
   void load(std::int64_t r) {
     const std::string context = "trace " + quoted(c_.file) + ", dataset " + quoted(c_.path);
     start_ = r;
@@ -401,29 +385,12 @@ class BlockReader {
     h5::Handle file_space = h5::checked(H5Dget_space(c_.dataset.get()), H5Sclose, context);
     const hsize_t offset[2] = {static_cast<hsize_t>(start_), 0};
     const hsize_t count[2] = {static_cast<hsize_t>(count_), c_.width};
-    // A member of a compound table: a one-member memory type picks it out of the rows.
-    h5::Handle member_type;
-    hid_t read_type = memory_type<T>();
-    int rank = c_.rank;
-    if (!c_.member.empty()) {
-      rank = 1;
-      h5::Handle field;
-      if (c_.width > 1) {
-        const hsize_t dims[1] = {c_.width};
-        field = h5::checked(H5Tarray_create2(memory_type<T>(), 1, dims), H5Tclose, context);
-      } else {
-        field = h5::checked(H5Tcopy(memory_type<T>()), H5Tclose, context);
-      }
-      member_type = h5::checked(H5Tcreate(H5T_COMPOUND, sizeof(T) * c_.width), H5Tclose, context);
-      h5::check(H5Tinsert(member_type.get(), c_.member.c_str(), 0, field.get()), context);
-      read_type = member_type.get();
-    }
     h5::check(H5Sselect_hyperslab(file_space.get(), H5S_SELECT_SET, offset, nullptr, count,
                                   nullptr),
               context);
-    h5::Handle mem_space = h5::checked(H5Screate_simple(rank, count, nullptr), H5Sclose,
+    h5::Handle mem_space = h5::checked(H5Screate_simple(c_.rank, count, nullptr), H5Sclose,
                                        context);
-    h5::check(H5Dread(c_.dataset.get(), read_type, mem_space.get(), file_space.get(),
+    h5::check(H5Dread(c_.dataset.get(), memory_type<T>(), mem_space.get(), file_space.get(),
                       H5P_DEFAULT, buffer_.data()),
               context + ": cannot read rows " + std::to_string(start_) + " to " +
                   std::to_string(start_ + count_ - 1));

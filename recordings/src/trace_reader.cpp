@@ -44,7 +44,6 @@ DType dtype_of(hid_t type, const std::string& context) {
 // of dataset "/physics"), or an intermediate name of members ("/physics/objects": a "group").
 struct Location {
   h5::Handle object;         // the dataset or group at the path, or the table dataset
-  std::string table;         // path of the table dataset ("" for a plain object)
   std::string member;        // member name, or member prefix for a group of members
   bool member_prefix = false;   // `member` names a group of members, not one
 };
@@ -85,7 +84,6 @@ Location locate(hid_t file, const std::string& path, const std::string& context)
       }
       if (exact || below) {
         out.object = std::move(object);
-        out.table = prefix;
         out.member = rest;
         out.member_prefix = !exact;
       }
@@ -100,34 +98,9 @@ Location locate(hid_t file, const std::string& path, const std::string& context)
   return out;
 }
 
-// The member's type within the table's row type (an array type for a width > 1 column).
-struct MemberType {
-  h5::Handle type;      // file type of the member
-  h5::Handle base;      // element type (the member, or the array's base)
-  std::size_t width = 1;
-};
-
-MemberType member_type(hid_t dataset, const std::string& member, const std::string& context) {
-  h5::Handle row = h5::checked(H5Dget_type(dataset), H5Tclose, context);
-  const int index = H5Tget_member_index(row.get(), member.c_str());
-  if (index < 0) throw TraceError(context + ": no member " + quoted(member));
-  MemberType out;
-  out.type = h5::checked(H5Tget_member_type(row.get(), static_cast<unsigned>(index)), H5Tclose, context);
-  if (H5Tget_class(out.type.get()) == H5T_ARRAY) {
-    if (H5Tget_array_ndims(out.type.get()) != 1) throw TraceError(context + ": not a 1-D array member");
-    hsize_t dims[1] = {0};
-    H5Tget_array_dims2(out.type.get(), dims);
-    out.width = static_cast<std::size_t>(dims[0]);
-    out.base = h5::checked(H5Tget_super(out.type.get()), H5Tclose, context);
-  } else {
-    out.base = h5::checked(H5Tcopy(out.type.get()), H5Tclose, context);
-  }
-  return out;
-}
-
 }  // namespace
 
-namespace detail {
+namespace {
 
 // Reads one member of a compound table into `out` (memory type `element`, width values a row):
 // a memory compound type with only that member makes HDF5 pick it out of every row.
@@ -147,7 +120,7 @@ void read_member(hid_t dataset, const std::string& member, hid_t element, std::s
             context + ": cannot read");
 }
 
-}  // namespace detail
+}  // namespace
 
 Dataset read_dataset(const std::string& file, const std::string& path) {
   h5::Lock lock;
@@ -169,8 +142,8 @@ Dataset read_dataset(const std::string& file, const std::string& path) {
   if (!where.member.empty()) {
     // A column of a table: shape (n,) or (n, width).
     if (rank != 1) throw TraceError(context + ": its table is not 1-D");
-    const MemberType m = member_type(where.object.get(), where.member, context);
-    out.dtype = dtype_of(m.base.get(), context);
+    const h5::Member m = h5::member_of(where.object.get(), where.member, context);
+    out.dtype = dtype_of(m.element.get(), context);
     const std::size_t rows = static_cast<std::size_t>(dims[0]);
     out.shape.push_back(rows);
     if (m.width > 1) out.shape.push_back(m.width);
@@ -178,11 +151,11 @@ Dataset read_dataset(const std::string& file, const std::string& path) {
     out.values.resize(count);
     if (count > 0 && out.dtype == DType::kUInt64) {
       out.bits.resize(count);
-      detail::read_member(where.object.get(), where.member, H5T_NATIVE_UINT64, m.width,
+      read_member(where.object.get(), where.member, H5T_NATIVE_UINT64, m.width,
                           out.bits.data(), context);
       for (std::size_t i = 0; i < count; ++i) out.values[i] = static_cast<double>(out.bits[i]);
     } else if (count > 0) {
-      detail::read_member(where.object.get(), where.member, H5T_NATIVE_DOUBLE, m.width,
+      read_member(where.object.get(), where.member, H5T_NATIVE_DOUBLE, m.width,
                           out.values.data(), context);
     }
     const std::string units = where.member + "/units";

@@ -273,7 +273,6 @@ class TraceWriterWorker {
 // What the writer and its tables share about the file.
 struct TraceFileState {
   hid_t file = H5I_INVALID_HID;   // not owned (TraceWriter::Impl::file)
-  std::string context;            // "trace 'PATH'"
   TraceOptions options;
   bool frozen = false;            // a row was appended: no new table, column or attribute
   std::function<void()> freeze;   // TraceWriter::Impl::freeze
@@ -711,7 +710,6 @@ TraceWriter::TraceWriter(const std::string& path, TraceOptions options)
   impl_->file = h5::checked(H5Fcreate(path.c_str(), H5F_ACC_TRUNC, fcpl.get(), fapl.get()),
                             H5Fclose, where);
   impl_->state.file = impl_->file.get();
-  impl_->state.context = impl_->context();
   impl_->state.options = options;
   impl_->state.freeze = [impl = impl_.get()] { impl->freeze(); };
   impl_->root = h5::checked(H5Gopen2(impl_->file.get(), "/", H5P_DEFAULT), H5Gclose, where);
