@@ -1,6 +1,6 @@
 // The real-time pacer (issue 6, item 5) on an injected clock: no wall-clock thresholds. A tick
 // whose work ends after start + (n + 1) T is an overrun, one that ends more than the stall
-// timeout after it is a stall; an early tick sleeps to its deadline exactly. In a run, an
+// timeout after the previous tick ended is a stall; an early tick sleeps to its deadline exactly. In a run, an
 // artificially slow device read is counted and flagged in /devices, and a stall releases every
 // device and stops the run.
 #include <catch2/catch.hpp>
@@ -73,20 +73,54 @@ TEST_CASE("Pacer: on-time ticks sleep to their deadlines, a slow one is one over
   }
 }
 
-TEST_CASE("Pacer: lateness past the stall timeout is a stall", "[pacer]") {
-  // Timeout 20 ms at 1 kHz: a tick that ends 19 ms late is an overrun, 21 ms late a stall.
+TEST_CASE("Pacer: a gap between two ticks past the stall timeout is a stall", "[pacer]") {
+  // The law: tick n stalls when its end follows tick n-1's end (tick 0: start()) by more than
+  // the timeout; how late it is against the schedule does not matter. Timeout 20 ms at 1 kHz
+  // (T = 1 ms), times in ns on the fake clock, exact.
   FakeClock clock;
   app::Pacer pacer(clock, 1000, 0.02);
   pacer.start();
-  clock.t += 20'000'000;   // ends 19 ms after its deadline of 1 ms
+  clock.t += 20'000'000;   // tick 0 ends 20 ms after start: gap 20 ms (not more), 19 ms late
   app::TickPace p = pacer.end_tick(0);
   CHECK(p.overrun);
+  CHECK(p.gap == Approx(0.020).margin(1e-12));
+  CHECK(p.lateness == Approx(0.019).margin(1e-12));
   CHECK_FALSE(p.stalled);
-  clock.t += 3'000'000;    // tick 1: deadline 2 ms, ends at 23 ms: 21 ms late
+  clock.t += 3'000'000;    // tick 1: 21 ms late, but its forces follow tick 0's by 3 ms
   p = pacer.end_tick(1);
+  CHECK(p.overrun);
+  CHECK(p.lateness == Approx(0.021).margin(1e-12));
+  CHECK_FALSE(p.stalled);
+  clock.t += 20'000'001;   // tick 2: 1 ns more than the timeout after tick 1
+  p = pacer.end_tick(2);
   CHECK(p.stalled);
+  CHECK(pacer.worst_gap() == Approx(0.020000001).margin(1e-12));
   CHECK_THROWS_WITH(app::Pacer(clock, 0, 0.02), Catch::Contains("rate must be > 0"));
   CHECK_THROWS_WITH(app::Pacer(clock, 1000, 0.0), Catch::Contains("stall timeout"));
+}
+
+TEST_CASE("Pacer: a loop steadily slower than its rate falls behind but never stalls", "[pacer]") {
+  // Every tick's work takes w = s T with s > 1: tick n ends at start + (n + 1) s T, so its
+  // lateness is (n + 1)(s - 1) T, growing without bound, and every gap is s T. Swept over s:
+  // with s T under the timeout (20 ms) no tick stalls however late; at s T over it the first
+  // tick already does. 1000 ticks at 1 kHz.
+  for (const double s : {1.05, 2.0, 19.0, 21.0}) {
+    FakeClock clock;
+    app::Pacer pacer(clock, 1000, 0.02);
+    pacer.start();
+    const auto work = static_cast<std::int64_t>(std::llround(s * 1e6));
+    std::int64_t stalls = 0;
+    for (std::int64_t n = 0; n < 1000; ++n) {
+      clock.t += work;
+      const app::TickPace p = pacer.end_tick(n);
+      stalls += p.stalled;
+      if (!p.overrun) FAIL("tick " << n << " on time at s = " << s);
+    }
+    const double last_lateness = 1000.0 * static_cast<double>(work - 1'000'000) * 1e-9;
+    CHECK(pacer.worst_lateness() == Approx(last_lateness).margin(1e-9));
+    CHECK(pacer.worst_gap() == Approx(static_cast<double>(work) * 1e-9).margin(1e-12));
+    CHECK(stalls == (s * 1e-3 > 0.02 ? 1000 : 0));
+  }
 }
 
 namespace {
@@ -162,7 +196,8 @@ TEST_CASE("A paced run that stalls past the timeout releases every device and st
     return std::make_unique<SlowFinger>(scenario.make_trajectory(f), clock, f == 1 ? 4500 : -1, 30'000'000, last[f]);
   };
   const app::RunResult r = app::run_scenario(scenario, o);
-  CHECK_THAT(r.error, Catch::Contains("the servo loop stalled: tick 4500") && Catch::Contains("every device was released"));
+  CHECK_THAT(r.error, Catch::Contains("the servo loop stalled: tick 4500's forces went out 30.000 ms after") &&
+                          Catch::Contains("every device was released"));
   CHECK(r.servo_ticks == 4500);
   CHECK(last[0] == hw::Vec3::Zero());
   CHECK(last[1] == hw::Vec3::Zero());

@@ -110,7 +110,11 @@ DeviceRegistry default_registry() {
   // A simulated device is not real (no hand on it): the run stays as fast as possible and
   // deterministic. UDP and OpenHaptics devices are real: the run is paced.
   r.add({"sim-phantom", "sim-phantom[:MODEL]", false, true, make_sim_phantom_device});
-  r.add({"udp", "udp:HOST:PORT", true, true, make_udp});
+  // In lockstep the peer (a device server replaying or simulating a hand) answers every datagram
+  // and waits for us: nobody's hand is on it in real time, so the run is not paced, and a slow
+  // moment of the machine cannot stop it (it did, with a 20 ms stall on a shared VM).
+  r.add({"udp", "udp:HOST:PORT", true, true, make_udp,
+         [](const std::string& arg) { return hw::parse_udp_spec(arg).lockstep; }});
   r.add({"phantom", "phantom:NAME", true, true, make_phantom});
   return r;
 }
@@ -181,7 +185,15 @@ DevicePlan plan_devices(const scripting::Scenario& scenario, const std::vector<s
       throw DeviceError("finger '" + model.fingers[f].name + "': device '" + plan.specs[f].text + "': the " + kind->name +
                         " backend is not built into this binary (built: " + built_kinds(registry) + ")");
     }
-    plan.real.push_back(kind->real);
+    bool real = kind->real;
+    if (real && kind->waits_for_graspsim) {
+      try {
+        real = !kind->waits_for_graspsim(plan.specs[f].arg);
+      } catch (const std::exception& e) {
+        throw DeviceError("finger '" + model.fingers[f].name + "': device '" + plan.specs[f].text + "': " + e.what());
+      }
+    }
+    plan.real.push_back(real);
   }
   return plan;
 }

@@ -49,6 +49,10 @@ struct DeviceKind {
   bool real = false;         // a device in the real world (a hand on it): the run is paced in real time
   bool mapped = true;        // gives device-frame samples: the scenario's workspace mapping applies
   DeviceFactory factory;     // empty: not built into this binary (an error naming the kind)
+  // Set for a real kind whose spec can ask it to wait for graspsim (co-simulation, e.g.
+  // `udp:...,lockstep`): true for such a spec, whose device then counts as not real (the run is
+  // not paced: the peer answers every datagram, so wall time decides nothing).
+  std::function<bool(const std::string& arg)> waits_for_graspsim = {};
 };
 
 class DeviceRegistry {
@@ -72,7 +76,7 @@ DeviceSpec parse_device_spec(const std::string& text, const DeviceRegistry& regi
 // One spec per finger of a scenario: the scenario's defaults, then the --device options.
 struct DevicePlan {
   std::vector<DeviceSpec> specs;   // Model::fingers order
-  std::vector<bool> real;          // per finger: DeviceKind::real
+  std::vector<bool> real;          // per finger: DeviceKind::real, unless the spec waits for graspsim
   bool any_real() const;
   // Fingers whose device is not "scripted": their samples go to /devices/<finger> in the trace.
   std::vector<bool> recorded() const;

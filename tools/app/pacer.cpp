@@ -33,9 +33,9 @@ Pacer::Pacer(MonotonicClock& clock, int rate, double stall_timeout)
 }
 
 void Pacer::start() {
-  start_ns_ = clock_.now_ns();
+  start_ns_ = last_end_ns_ = clock_.now_ns();
   overruns_ = ticks_ = 0;
-  worst_ = 0.0;
+  worst_ = worst_gap_ = 0.0;
 }
 
 TickPace Pacer::end_tick(std::int64_t n) {
@@ -45,22 +45,29 @@ TickPace Pacer::end_tick(std::int64_t n) {
   const std::int64_t deadline = start_ns_ + (n + 1) * 1000000000 / rate_;
   const std::int64_t now = clock_.now_ns();
   ++ticks_;
+  pace.gap = static_cast<double>(now - last_end_ns_) * 1e-9;
+  pace.stalled = now - last_end_ns_ > stall_ns_;
+  if (pace.gap > worst_gap_) worst_gap_ = pace.gap;
   if (now > deadline) {
     pace.overrun = true;
     pace.lateness = static_cast<double>(now - deadline) * 1e-9;
-    pace.stalled = now - deadline > stall_ns_;
     ++overruns_;
     if (pace.lateness > worst_) worst_ = pace.lateness;
+    last_end_ns_ = now;
   } else {
     clock_.sleep_until_ns(deadline);
+    last_end_ns_ = deadline;   // the next tick's work starts at the deadline, not when we woke
   }
   return pace;
 }
 
 std::string Pacer::summary() const {
-  char buf[128];
-  std::snprintf(buf, sizeof buf, "%lld of %lld ticks overran their deadline (worst %.3f ms late)",
-                static_cast<long long>(overruns_), static_cast<long long>(ticks_), worst_ * 1e3);
+  char buf[160];
+  std::snprintf(buf, sizeof buf,
+                "%lld of %lld ticks overran their deadline (worst %.3f ms late), longest gap between "
+                "ticks %.3f ms",
+                static_cast<long long>(overruns_), static_cast<long long>(ticks_), worst_ * 1e3,
+                worst_gap_ * 1e3);
   return buf;
 }
 

@@ -1,8 +1,9 @@
 // Real-time pacing of the lockstep loop (issue 6, item 5): with a real device attached, servo
 // tick n must finish by start + (n + 1) / rate on a monotonic clock. The pacer sleeps until that
-// deadline, counts the ticks that miss it (overruns), and reports a stall (a tick that ends more
-// than `stall_timeout` past its deadline) so that the run loop releases every device. The clock
-// is injected: tests drive a fake one (no wall-clock thresholds), runs use SteadyClock.
+// deadline, counts the ticks that miss it (overruns), and reports a stall (a tick whose forces
+// went out more than `stall_timeout` after the previous tick's) so that the run loop releases
+// every device. The clock is injected: tests drive a fake one (no wall-clock thresholds), runs
+// use SteadyClock.
 #pragma once
 
 #include <cstdint>
@@ -36,13 +37,22 @@ class SteadyClock final : public MonotonicClock {
 
 struct TickPace {
   bool overrun = false;        // the tick's work ended after its deadline
-  bool stalled = false;        // ... by more than the stall timeout
+  bool stalled = false;        // its forces followed the previous tick's by more than the timeout
   double lateness = 0.0;       // s: how far past the deadline (0 when on time)
+  double gap = 0.0;            // s: since the previous tick ended (tick 0: since start())
 };
 
 class Pacer {
  public:
-  // rate: servo ticks per second (> 0); stall_timeout (s, > 0): lateness that counts as a stall.
+  // rate: servo ticks per second (> 0); stall_timeout (s, > 0): the longest a device may hold
+  // one force, i.e. the gap between two ticks' ends that counts as a stall.
+  //
+  // A stall is measured by the gap, not by the lateness against the schedule: the hazard is a
+  // device holding a stale force, and a loop that runs steadily a little slower than its rate
+  // (lateness growing by a few us a tick) refreshes every force in time. Lateness is what
+  // overruns count; a loop that is late for long is slow motion, not danger, and the summary
+  // shows it. (Until session 4 a lateness past the timeout was a stall: loopback UDP on a
+  // shared VM then stopped runs whose longest gap was a few ms.)
   Pacer(MonotonicClock& clock, int rate, double stall_timeout);
   void start();                        // tick 0's period begins now
   // After tick n's work: returns how it kept its deadline start + (n + 1) / rate, and sleeps
@@ -53,16 +63,19 @@ class Pacer {
   std::int64_t overruns() const { return overruns_; }
   std::int64_t ticks() const { return ticks_; }
   double worst_lateness() const { return worst_; }   // s
+  double worst_gap() const { return worst_gap_; }    // s: the longest gap between two ticks' ends
   double stall_timeout() const { return static_cast<double>(stall_ns_) * 1e-9; }   // s
-  std::string summary() const;   // "N of M ticks overran (worst X ms late)"
+  std::string summary() const;   // "N of M ticks overran (worst X ms late), longest gap Y ms"
 
  private:
   MonotonicClock& clock_;
   std::int64_t rate_;        // Hz
   std::int64_t start_ns_ = 0;
   std::int64_t stall_ns_;    // ns
+  std::int64_t last_end_ns_ = 0;   // ns: when the previous tick ended (its forces were out)
   std::int64_t overruns_ = 0, ticks_ = 0;
   double worst_ = 0.0;       // s
+  double worst_gap_ = 0.0;   // s
 };
 
 // Real-time scheduling of the calling thread (SCHED_FIFO at a middle priority), where the system

@@ -317,10 +317,12 @@ RunResult run_scenario(const scripting::Scenario& scenario, const RunOptions& op
         pace = options.pacer->end_tick(n);
         if (pace.stalled) {
           release_all();
-          throw std::runtime_error("the servo loop stalled: tick " + std::to_string(n) + " ended " +
-                                   std::to_string(pace.lateness * 1e3) + " ms past its deadline (timeout " +
-                                   std::to_string(options.pacer->stall_timeout() * 1e3) +
-                                   " ms); every device was released");
+          char why[200];
+          std::snprintf(why, sizeof why,
+                        "the servo loop stalled: tick %lld's forces went out %.3f ms after the previous "
+                        "tick's (stall timeout %.3f ms); every device was released",
+                        static_cast<long long>(n), pace.gap * 1e3, options.pacer->stall_timeout() * 1e3);
+          throw std::runtime_error(why);
         }
       }
       for (const DeviceColumns& c : device_tables) {
