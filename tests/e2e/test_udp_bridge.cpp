@@ -74,9 +74,15 @@ std::vector<PrintedForce> printed_forces(const std::string& out) {
   return forces;
 }
 
+// The link under test, with the device's force safety reduced to the clamp: its continuous
+// force set to the peak (no thermal derating) and no ramp, so every force the server receives is
+// the clamped request bit for bit (the safety law: tests/hw/test_udp_safety.cpp).
 UdpDeviceConfig config_for(const Server& server, double max_force) {
-  UdpDeviceConfig c = parse_udp_spec("127.0.0.1:" + std::to_string(server.port()) + ",timeout=0.05,lockstep");
+  const std::string f = std::to_string(max_force);
+  UdpDeviceConfig c = parse_udp_spec("127.0.0.1:" + std::to_string(server.port()) +
+                                     ",timeout=0.05,lockstep,max_force=" + f + ",continuous_force=" + f);
   c.limits = DeviceLimits{max_force};
+  c.safety.rise_time = 0.0;
   return c;
 }
 
