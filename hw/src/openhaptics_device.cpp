@@ -207,11 +207,12 @@ HDCallbackCode HDCALLBACK Session::servo_frame(void* data) {
       s->box.mutex.unlock();
     }
     s->frames_since_request = fresh ? 0 : s->frames_since_request + 1;
-    if (released || s->frames_since_request >= kStallFrames) s->safety->release();   // zero, re-armed
-    if (fresh) s->safety->request(Vec3(request[0], request[1], request[2]), t);
+    // Zero (and the ramp re-armed) after a release, a stall, or for good after an HD error.
+    const bool faulted = HD_DEVICE_ERROR(s->fault);
+    if (released || faulted || s->frames_since_request >= kStallFrames) s->safety->release();
+    if (fresh && !faulted) s->safety->request(Vec3(request[0], request[1], request[2]), t);
     // Every frame: the thermal state advances over the frame with the force held in it.
-    Vec3 out = s->safety->output(t);
-    if (HD_DEVICE_ERROR(s->fault)) out = Vec3::Zero();
+    const Vec3 out = s->safety->output(t);
     const std::array<double, 3> force{out.x(), out.y(), out.z()};
     hdSetDoublev(HD_CURRENT_FORCE, force.data());
     hdEndFrame(s->handle);
@@ -307,7 +308,7 @@ Slot* Session::open(const std::string& name, const OpenHapticsOptions& options) 
            ", not a positive number; refusing to render forces with it");
   slot->nominal = PhantomNominal{peak, continuous, stiffness * 1000.0};   // N/mm -> N/m
   // The device clock's rate: HD_UPDATE_RATE (Hz) when it gives a positive number, else the HD
-  // scheduler's default (describe() says which).
+  // scheduler's default (rate() says which).
   HDint rate = 0;
   hdGetIntegerv(HD_UPDATE_RATE, &rate);
   take_error();
