@@ -12,11 +12,14 @@
 
 #include <HD/hd.h>
 
+#include "graspsim/hw/force_safety.hpp"
+
 #include <array>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <mutex>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -87,11 +90,13 @@ struct Mailbox {
   std::array<double, 3> position_mm{0.0, 0.0, 0.0};   // mm, OpenHaptics axes
   std::array<double, 3> gimbal{0.0, 0.0, 0.0};        // rad, HD_CURRENT_GIMBAL_ANGLES
   std::uint32_t buttons = 0;                          // HD_CURRENT_BUTTONS bits
-  std::uint64_t frames = 0;                           // servo frames published so far
+  std::int64_t frame = -1;                            // servo frame the sample was read in
   HDErrorInfo fault{HD_SUCCESS, 0, HD_INVALID_HANDLE};   // first HD error seen in a frame
   // Written by graspsim, read by the servo thread.
   std::array<double, 3> force_hd{0.0, 0.0, 0.0};   // N, OpenHaptics axes, already clamped
   std::uint64_t requests = 0;                      // force requests so far
+  std::uint64_t releases = 0;                      // release() calls so far
+  std::uint64_t released_at = 0;                   // `requests` at the last release()
 };
 
 struct Slot {
@@ -100,10 +105,13 @@ struct Slot {
   std::string opened;      // the configured name that opened ("" for HD_DEFAULT_DEVICE)
   std::string model;       // HD_DEVICE_MODEL_TYPE
   PhantomNominal nominal;
+  double rate = kOpenHapticsDefaultRate;   // Hz: frames per second of the device clock
   Mailbox box;
-  // Servo thread only.
-  std::array<double, 3> servo_force{0.0, 0.0, 0.0};   // N, OpenHaptics axes: what it renders
+  // Servo thread only (set up before the scheduler first serves the slot).
+  std::optional<ForceSafety> safety;   // nominal peak and continuous force, on the frame clock
+  std::int64_t frame = 0;              // servo frames served so far: frame k runs at k / rate s
   std::uint64_t seen_requests = 0;
+  std::uint64_t seen_releases = 0;
   std::uint64_t frames_since_request = 0;
   HDErrorInfo fault{HD_SUCCESS, 0, HD_INVALID_HANDLE};   // first HD error in a frame; sticky
 };
@@ -117,7 +125,7 @@ class Session {
     return session;
   }
 
-  Slot* open(const std::string& name);
+  Slot* open(const std::string& name, const OpenHapticsOptions& options);
   void close(Slot* slot);
   std::mutex& mutex() { return mutex_; }
 
@@ -175,25 +183,38 @@ HDCallbackCode HDCALLBACK Session::servo_frame(void* data) {
   for (Slot* s : self->slots_) {
     std::array<double, 3> position{0.0, 0.0, 0.0}, gimbal{0.0, 0.0, 0.0};
     HDint buttons = 0;
+    const double t = static_cast<double>(s->frame) / s->rate;   // s, the device's frame clock
     hdMakeCurrentDevice(s->handle);
     hdBeginFrame(s->handle);
     hdGetDoublev(HD_CURRENT_POSITION, position.data());
     hdGetDoublev(HD_CURRENT_GIMBAL_ANGLES, gimbal.data());
     hdGetIntegerv(HD_CURRENT_BUTTONS, &buttons);
-    // Take graspsim's latest request if the mailbox is free; otherwise hold the last force.
-    bool fresh = false;
+    // Take graspsim's latest request and release if the mailbox is free; otherwise hold. A
+    // release re-arms the ramp; the zero it sent is not a request of its own (a request made
+    // after it is, and ramps in from this frame).
+    bool fresh = false, released = false;
+    std::array<double, 3> request{0.0, 0.0, 0.0};
     if (s->box.mutex.try_lock()) {
+      if (s->box.releases != s->seen_releases) {
+        s->seen_releases = s->box.releases;
+        released = true;
+      }
       if (s->box.requests != s->seen_requests) {
         s->seen_requests = s->box.requests;
-        s->servo_force = s->box.force_hd;
-        fresh = true;
+        request = s->box.force_hd;
+        fresh = !released || s->box.requests != s->box.released_at;
       }
       s->box.mutex.unlock();
     }
     s->frames_since_request = fresh ? 0 : s->frames_since_request + 1;
-    if (s->frames_since_request >= kStallFrames || HD_DEVICE_ERROR(s->fault))
-      s->servo_force = {0.0, 0.0, 0.0};
-    hdSetDoublev(HD_CURRENT_FORCE, s->servo_force.data());
+    // Zero (and the ramp re-armed) after a release, a stall, or for good after an HD error.
+    const bool faulted = HD_DEVICE_ERROR(s->fault);
+    if (released || faulted || s->frames_since_request >= kStallFrames) s->safety->release();
+    if (fresh && !faulted) s->safety->request(Vec3(request[0], request[1], request[2]), t);
+    // Every frame: the thermal state advances over the frame with the force held in it.
+    const Vec3 out = s->safety->output(t);
+    const std::array<double, 3> force{out.x(), out.y(), out.z()};
+    hdSetDoublev(HD_CURRENT_FORCE, force.data());
     hdEndFrame(s->handle);
     const HDErrorInfo e = take_error();
     if (HD_DEVICE_ERROR(e) && !HD_DEVICE_ERROR(s->fault)) s->fault = e;   // zero from next frame
@@ -201,10 +222,11 @@ HDCallbackCode HDCALLBACK Session::servo_frame(void* data) {
       s->box.position_mm = position;
       s->box.gimbal = gimbal;
       s->box.buttons = static_cast<std::uint32_t>(buttons);
-      ++s->box.frames;
+      s->box.frame = s->frame;
       s->box.fault = s->fault;   // published on the first frame the mailbox is free
       s->box.mutex.unlock();
     }
+    ++s->frame;
   }
   return HD_CALLBACK_CONTINUE;
 }
@@ -231,7 +253,7 @@ std::vector<const char*> names_to_try(const std::string& name) {
   return names;
 }
 
-Slot* Session::open(const std::string& name) {
+Slot* Session::open(const std::string& name, const OpenHapticsOptions& options) {
   // hdInitDevice is not for a running scheduler: pause it (a start-up step; forces are zero).
   stop();
   auto* slot = new Slot;
@@ -285,6 +307,23 @@ Slot* Session::open(const std::string& name) {
       fail(std::string("reports ") + what + " = " + std::to_string(value) +
            ", not a positive number; refusing to render forces with it");
   slot->nominal = PhantomNominal{peak, continuous, stiffness * 1000.0};   // N/mm -> N/m
+  // The device clock's rate: HD_UPDATE_RATE (Hz) when it gives a positive number, else the HD
+  // scheduler's default (rate() says which).
+  HDint rate = 0;
+  hdGetIntegerv(HD_UPDATE_RATE, &rate);
+  take_error();
+  slot->rate = rate > 0 ? static_cast<double>(rate) : static_cast<double>(kOpenHapticsDefaultRate);
+  ForceSafetyConfig safety;
+  safety.peak_force = peak;
+  safety.continuous_force = continuous;
+  safety.thermal_time_constant = options.thermal_time_constant;
+  safety.rise_time = options.rise_time;
+  safety.stall_timeout = static_cast<double>(kStallFrames) / slot->rate;   // the servo's own stall
+  try {
+    slot->safety.emplace(safety);
+  } catch (const std::invalid_argument& e) {
+    fail(std::string("its force safety cannot be set up from its nominal limits: ") + e.what());
+  }
   const HDstring model = hdGetString(HD_DEVICE_MODEL_TYPE);
   take_error();   // the model is only for messages
   slot->model = model ? model : "";
@@ -345,6 +384,8 @@ class PhantomDevice final : public OpenHapticsDevice {
       s.gimbal = Vec3(slot_->box.gimbal[0], slot_->box.gimbal[1], slot_->box.gimbal[2]);
       s.buttons = slot_->box.buttons;
       fault = slot_->box.fault;
+      new_frames_ = slot_->box.frame - frame_;
+      frame_ = slot_->box.frame;
     }
     if (HD_DEVICE_ERROR(fault))
       throw std::runtime_error("OpenHaptics device " + quoted(slot_->requested) +
@@ -359,6 +400,11 @@ class PhantomDevice final : public OpenHapticsDevice {
   }
   PhantomNominal nominal() const override { return slot_->nominal; }
   std::string config_name() const override { return slot_->opened; }
+  double rate() const override { return slot_->rate; }
+  // s: the last read sample's servo frame on the device clock, k / rate.
+  double sample_time() const override { return static_cast<double>(frame_) / slot_->rate; }
+  std::int64_t sample_sequence() const override { return frame_; }   // its servo frame k
+  std::int64_t new_samples() const override { return new_frames_; }  // frames since the read before
 
  protected:
   // `force` (N, device frame) is already clamped by Device::render.
@@ -368,17 +414,26 @@ class PhantomDevice final : public OpenHapticsDevice {
     slot_->box.force_hd = f;
     ++slot_->box.requests;
   }
+  // After release()'s zero: the servo callback re-arms the ramp (ForceSafety::release).
+  void on_release() override {
+    std::lock_guard<std::mutex> lock(slot_->box.mutex);
+    ++slot_->box.releases;
+    slot_->box.released_at = slot_->box.requests;
+  }
 
  private:
   Slot* slot_;   // owned by the Session while the device is open
+  std::int64_t frame_ = -1;       // servo frame of the last read sample (-1: none read yet)
+  std::int64_t new_frames_ = 0;   // frames between the previous read's sample and the last
 };
 
 }  // namespace
 
-std::unique_ptr<Device> make_openhaptics_device(const std::string& device_name) {
+std::unique_ptr<Device> make_openhaptics_device(const std::string& device_name,
+                                                const OpenHapticsOptions& options) {
   Session& session = Session::instance();
   std::lock_guard<std::mutex> lock(session.mutex());
-  return std::make_unique<PhantomDevice>(session.open(device_name));
+  return std::make_unique<PhantomDevice>(session.open(device_name, options));
 }
 
 }  // namespace graspsim::hw

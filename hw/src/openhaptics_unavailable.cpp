@@ -6,7 +6,7 @@
 
 namespace graspsim::hw {
 
-std::unique_ptr<Device> make_openhaptics_device(const std::string& device_name) {
+std::unique_ptr<Device> make_openhaptics_device(const std::string& device_name, const OpenHapticsOptions&) {
   throw std::runtime_error("OpenHaptics device \"" + device_name +
                            "\": graspsim was built without OpenHaptics: install the SDK and "
                            "reconfigure with -DGRASPSIM_OPENHAPTICS=ON (see hw/README.md)");

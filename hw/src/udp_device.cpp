@@ -1,13 +1,17 @@
 // UdpDevice and UdpLink (hw/README.md, "UDP protocol").
 #include "graspsim/hw/udp_device.hpp"
 
+#include "graspsim/hw/device_models.hpp"
+
 #include <algorithm>
 #include <arpa/inet.h>
 #include <cerrno>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <netdb.h>
+#include <optional>
 #include <netinet/in.h>
 #include <poll.h>
 #include <stdexcept>
@@ -15,6 +19,14 @@
 #include <unistd.h>
 
 namespace graspsim::hw {
+
+ForceSafetyConfig udp_safety_of_model(const std::string& key) {
+  const DeviceModel& m = device_model(key);
+  ForceSafetyConfig c;
+  c.peak_force = m.peak_force;
+  c.continuous_force = m.continuous_force;
+  return c;
+}
 
 // ---- UdpLink --------------------------------------------------------------------------------
 
@@ -79,7 +91,26 @@ double wall_now() {
 
 }  // namespace
 
-UdpDevice::UdpDevice(const UdpDeviceConfig& config) : config_(config), link_(config.timeout_s) {
+namespace {
+
+ForceSafety checked_safety(const UdpDeviceConfig& c) {
+  try {
+    return ForceSafety(c.safety);
+  } catch (const std::invalid_argument& e) {
+    throw std::invalid_argument("udp device " + endpoint(c) + ": " + e.what());
+  }
+}
+
+std::string newtons(double f) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.6g N", f);
+  return buf;
+}
+
+}  // namespace
+
+UdpDevice::UdpDevice(const UdpDeviceConfig& config)
+    : config_(config), link_(config.timeout_s), safety_(checked_safety(config)) {
   const std::string where = "udp device " + endpoint(config);
   if (config.port == 0) throw std::runtime_error(where + ": the server port must be 1 to 65535");
   addrinfo hints{};
@@ -118,7 +149,12 @@ UdpDevice::~UdpDevice() {
 }
 
 std::string UdpDevice::describe() const {
-  return "udp " + endpoint(config_) + (config_.lockstep ? " (lockstep)" : "");
+  return "udp " + endpoint(config_) + (config_.lockstep ? " (lockstep)" : "") + " (" + config_.model + ": " +
+         newtons(config_.safety.peak_force) + " peak, " + newtons(config_.safety.continuous_force) + " continuous)";
+}
+
+DeviceLimits UdpDevice::limits() const {
+  return DeviceLimits{std::min(config_.limits.max_force, config_.safety.peak_force)};
 }
 
 void UdpDevice::send(const std::uint8_t* data, std::size_t size) {
@@ -176,11 +212,22 @@ DeviceSample UdpDevice::read(std::int64_t /*tick*/, double time) {
     }
   }
   drain();
-  return link_.read(time);
+  const DeviceSample s = link_.read(time);
+  // Accepted since the previous read (the handshake's samples count at the first read).
+  new_samples_ = static_cast<std::int64_t>(link_.counters().received - received_at_read_);
+  received_at_read_ = link_.counters().received;
+  time_ = time;
+  return s;
 }
 
 void UdpDevice::output(const Vec3& force) {
-  last_force_ = link_.link_lost() ? Vec3::Zero() : force;
+  // While the link is lost: zero, and the ramp re-armed for when it comes back. The safety's
+  // output() runs on every send, so its heat integrates the force actually sent (zero included).
+  if (link_.link_lost())
+    safety_.release();
+  else
+    safety_.request(force, time_);
+  last_force_ = safety_.output(time_);
   udp::Force m;
   m.sequence = sent_;
   m.answers = link_.newest().sequence;
@@ -231,8 +278,8 @@ bool parse_uint(const std::string& text, unsigned long max, unsigned long* out) 
 UdpDeviceConfig parse_udp_spec(const std::string& spec_in) {
   const auto fail = [&](const std::string& why) {
     return std::invalid_argument("udp device spec '" + spec_in + "': " + why +
-                                 " (expected HOST:PORT[,timeout=S][,local_port=N][,lockstep], "
-                                 "e.g. 127.0.0.1:7001)");
+                                 " (expected HOST:PORT[,timeout=S][,local_port=N][,lockstep][,model=KEY]"
+                                 "[,max_force=N][,continuous_force=N], e.g. 127.0.0.1:7001,model=premium-1.5)");
   };
   std::string spec = spec_in;
   if (spec.rfind("udp:", 0) == 0) spec = spec.substr(4);
@@ -248,6 +295,20 @@ UdpDeviceConfig parse_udp_spec(const std::string& spec_in) {
     throw fail("port '" + address.substr(colon + 1) + "' is not a number from 1 to 65535");
   }
   c.port = static_cast<std::uint16_t>(port);
+  const auto positive = [&](const std::string& key, const std::string& value, const char* unit) {
+    std::size_t used = 0;
+    double v = 0.0;
+    try {
+      v = std::stod(value, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used != value.size() || value.empty() || !(v > 0.0) || !std::isfinite(v)) {
+      throw fail(key + " '" + value + "' is not a positive number of " + unit);
+    }
+    return v;
+  };
+  std::optional<double> max_force, continuous_force;   // N, explicit: over the model's
   while (!options.empty() || spec.size() > address.size()) {
     const std::string option = options.substr(0, options.find(','));
     options = option.size() < options.size() ? options.substr(option.size() + 1) : "";
@@ -257,17 +318,18 @@ UdpDeviceConfig parse_udp_spec(const std::string& spec_in) {
     if (key == "lockstep" && eq == std::string::npos) {
       c.lockstep = true;
     } else if (key == "timeout" && eq != std::string::npos) {
-      std::size_t used = 0;
-      double t = 0.0;
+      c.timeout_s = positive(key, value, "seconds");
+    } else if (key == "model" && eq != std::string::npos) {
       try {
-        t = std::stod(value, &used);
-      } catch (const std::exception&) {
-        used = 0;
+        c.safety = udp_safety_of_model(value);
+      } catch (const std::invalid_argument& e) {
+        throw fail(std::string("model: ") + e.what());
       }
-      if (used != value.size() || value.empty() || !(t > 0.0) || !std::isfinite(t)) {
-        throw fail("timeout '" + value + "' is not a positive number of seconds");
-      }
-      c.timeout_s = t;
+      c.model = value;
+    } else if (key == "max_force" && eq != std::string::npos) {
+      max_force = positive(key, value, "newtons");
+    } else if (key == "continuous_force" && eq != std::string::npos) {
+      continuous_force = positive(key, value, "newtons");
     } else if (key == "local_port" && eq != std::string::npos) {
       unsigned long local = 0;
       if (!parse_uint(value, 65535, &local)) throw fail("local_port '" + value + "' is not a number from 0 to 65535");
@@ -276,6 +338,17 @@ UdpDeviceConfig parse_udp_spec(const std::string& spec_in) {
       throw fail("unknown option '" + option + "'");
     }
     if (options.empty()) break;
+  }
+  // Explicit figures replace the model's, whatever the order they were given in.
+  if (max_force) c.safety.peak_force = *max_force;
+  if (continuous_force) c.safety.continuous_force = *continuous_force;
+  if (max_force || continuous_force) c.model += " with " + std::string(max_force ? "max_force" : "") +
+                                                (max_force && continuous_force ? ", " : "") +
+                                                (continuous_force ? "continuous_force" : "") + " given";
+  if (c.safety.continuous_force > c.safety.peak_force) {
+    throw fail("continuous_force " + std::to_string(c.safety.continuous_force) + " N is above max_force " +
+               std::to_string(c.safety.peak_force) + " N (" + (max_force ? "given" : "of the model") +
+               "): the continuous limit cannot exceed the peak");
   }
   return c;
 }

@@ -74,9 +74,15 @@ std::vector<PrintedForce> printed_forces(const std::string& out) {
   return forces;
 }
 
+// The link under test, with the device's force safety reduced to the clamp: its continuous
+// force set to the peak (no thermal derating) and no ramp, so every force the server receives is
+// the clamped request bit for bit (the safety law: tests/hw/test_udp_safety.cpp).
 UdpDeviceConfig config_for(const Server& server, double max_force) {
-  UdpDeviceConfig c = parse_udp_spec("127.0.0.1:" + std::to_string(server.port()) + ",timeout=0.05,lockstep");
+  const std::string f = std::to_string(max_force);
+  UdpDeviceConfig c = parse_udp_spec("127.0.0.1:" + std::to_string(server.port()) +
+                                     ",timeout=0.05,lockstep,max_force=" + f + ",continuous_force=" + f);
   c.limits = DeviceLimits{max_force};
+  c.safety.rise_time = 0.0;
   return c;
 }
 
@@ -245,6 +251,18 @@ TEST_CASE("graspsim run with a finger on the UDP bridge and its replay are bit f
   CHECK(run.status == 1);
   CHECK_THAT(run.output, !Catch::Contains("pacing"));
   CHECK(graspsim::recordings::read_dataset(session, "/devices/thumb/position").shape.at(0) == 6000);
+  // The device's own numbering and clock (hw::SampleCounter, SampleClock): in lockstep the server
+  // answers each datagram with the next sample, so tick n reads sample n, one new per tick, taken
+  // at n / 3000 s on the server's clock (`--lockstep`: device time = k / rate).
+  const auto sequence = graspsim::recordings::read_dataset(session, "/devices/thumb/sequence").values;
+  const auto fresh = graspsim::recordings::read_dataset(session, "/devices/thumb/new_samples").values;
+  const auto device_time = graspsim::recordings::read_dataset(session, "/devices/thumb/device_time").values;
+  REQUIRE(sequence.size() == 6000);
+  bool numbered = true;
+  for (std::size_t n = 0; n < sequence.size(); ++n)
+    numbered = numbered && sequence[n] == static_cast<double>(n) && fresh[n] == 1.0;
+  CHECK(numbered);
+  CHECK(device_time[2999] == Approx(2999.0 / 3000.0).epsilon(1e-12));
   // The device's samples are the scripted run's thumb, bit for bit.
   CHECK(graspsim::recordings::read_dataset(session, "/servo/fingers/thumb/hip").values ==
         graspsim::recordings::read_dataset(scripted, "/servo/fingers/thumb/hip").values);

@@ -34,6 +34,15 @@ std::array<double, 3> expected_hd_force(const Vec3& f) { return {f.x(), f.z(), -
 
 Vec3 as_vec(const std::array<double, 3>& a) { return Vec3(a[0], a[1], a[2]); }
 
+// The clamp and the servo's stall alone: no ramp, and a device whose continuous force is its peak
+// (no thermal derating), so the force committed is the clamped request bit for bit. The force
+// safety law itself is tested in test_openhaptics_safety.cpp.
+const graspsim::hw::OpenHapticsOptions kNoRamp{/*rise_time=*/0.0};
+std::unique_ptr<Device> open_clamp_only(hd_double::FakeDevice& fake, const std::string& name) {
+  fake.max_continuous_force = fake.max_force;
+  return make_openhaptics_device(name, kNoRamp);
+}
+
 // Every test starts from an empty double and must leave no API misuse behind.
 struct Fresh {
   Fresh() { hd_double::reset(); }
@@ -110,7 +119,7 @@ TEST_CASE("OpenHaptics: forces go out in N on HD axes, clamped to the nominal ma
     Fresh fresh;
     auto& fake = hd_double::add_device("P");
     fake.max_force = f_max;
-    auto dev = make_openhaptics_device("P");
+    auto dev = open_clamp_only(fake, "P");
     REQUIRE(dev->limits().max_force == f_max);
     INFO("F_max = " << f_max << " N");
 
@@ -240,8 +249,8 @@ TEST_CASE("OpenHaptics: one scheduler callback serves two devices, each with its
   thumb.position_mm = {10.0, 20.0, 30.0};
   index.position_mm = {-5.0, 0.0, 5.0};
   index.max_force = 3.3;
-  auto a = make_openhaptics_device("Thumb");
-  auto b = make_openhaptics_device("Index");
+  auto a = open_clamp_only(thumb, "Thumb");
+  auto b = open_clamp_only(index, "Index");
   CHECK(hd_double::scheduled_callbacks() == 1);
   CHECK(hd_double::scheduler_running());
   CHECK(a->read(0, 0.0).position == expected_position(thumb.position_mm));
@@ -279,7 +288,7 @@ TEST_CASE("OpenHaptics: the servo loop zeroes a force nobody renews", "[hw][open
   // and is zero from frame kOpenHapticsStallFrames on (counted in the device's own frames).
   Fresh fresh;
   auto& fake = hd_double::add_device("P");
-  auto dev = make_openhaptics_device("P");
+  auto dev = open_clamp_only(fake, "P");
   const Vec3 f(0.5, 0.5, 0.5);
   dev->render(f);
   hd_double::run_frames(1);   // takes the request

@@ -24,9 +24,13 @@ void feed(UdpLink& link, const udp::Sample& s) {
 
 bool same_bits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
 
+// The link's tests see the clamp alone: the device's safety with the same peak, no thermal
+// derating (C = P) and no ramp, so every force sent is the clamped request bit for bit.
 UdpDeviceConfig lockstep_config(const UdpPeer& peer, double timeout_s, double max_force) {
   UdpDeviceConfig c{"127.0.0.1", peer.port(), 0, timeout_s, DeviceLimits{max_force}};
   c.lockstep = true;
+  c.safety.peak_force = c.safety.continuous_force = max_force;
+  c.safety.rise_time = 0.0;
   return c;
 }
 
@@ -153,7 +157,7 @@ TEST_CASE("UdpLink: the link is lost exactly when no new sample came for longer 
 TEST_CASE("UdpDevice on loopback: samples in, forces out, sequence numbers checked", "[hw][udp][loopback]") {
   UdpPeer peer;
   UdpDevice d(lockstep_config(peer, 0.05, 5.0));
-  CHECK(d.describe() == "udp 127.0.0.1:" + std::to_string(peer.port()) + " (lockstep)");
+  CHECK(d.describe() == "udp 127.0.0.1:" + std::to_string(peer.port()) + " (lockstep) (touch: 5 N peak, 5 N continuous)");
   CHECK(peer.receive_hello().sequence == 0);
   for (std::uint32_t n = 0; n < 200; ++n) {
     const udp::Sample sent = line_sample(n);
@@ -265,6 +269,8 @@ TEST_CASE("UdpDevice: read never waits outside lockstep, and the first sample is
           "[hw][udp][loopback]") {
   UdpPeer peer;
   UdpDeviceConfig c{"127.0.0.1", peer.port(), 0, 0.05, DeviceLimits{5.0}};
+  c.safety.peak_force = c.safety.continuous_force = 5.0;   // the clamp alone (no derating, no ramp)
+  c.safety.rise_time = 0.0;
   UdpDevice d(c);
   // Nothing sent yet: the read returns at once, with no sample, counted as a hold; link lost,
   // so a force renders zero.

@@ -62,7 +62,8 @@ std::unique_ptr<hw::Device> make_sim_phantom_device(const DeviceContext& c) {
 }
 
 // A device served over UDP (hw/udp_device.hpp, hw/README.md "UDP protocol"); the finger's
-// force limit from the scenario is its clamp.
+// force limit from the scenario is its clamp, and the device's own limits (spec `model=KEY`,
+// default hw::kUdpDefaultModel, or `max_force=` / `continuous_force=`) its force safety.
 std::unique_ptr<hw::Device> make_udp(const DeviceContext& c) {
   hw::UdpDeviceConfig config = hw::parse_udp_spec(c.spec.arg);
   config.limits = c.scenario.fingers()[c.finger].limits;

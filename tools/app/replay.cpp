@@ -11,6 +11,7 @@
 
 #include "graspsim/hw/replay_device.hpp"
 #include "graspsim/hw/sample_clock.hpp"
+#include "graspsim/hw/sample_counter.hpp"
 #include "graspsim/recordings/trace_reader.hpp"
 #include "graspsim/recordings/trace_recorder.hpp"
 
@@ -49,7 +50,8 @@ std::vector<hw::Vec3> read_vec3(const std::string& trace, const std::string& pat
 // A device's recorded samples, row n at servo tick n, in its own frame, with their own clock
 // and the recorded pacing (so the run loop rewrites the same /devices row). The finger's script
 // still runs alongside, as for ReplayDevice.
-class DeviceRowsReplay final : public hw::Device, public hw::SampleClock, public RecordedPacing {
+class DeviceRowsReplay final : public hw::Device, public hw::SampleClock, public hw::SampleCounter,
+                               public RecordedPacing {
  public:
   DeviceRowsReplay(const RecordedDeviceRows& rows, hw::DeviceLimits limits, std::string source,
                    std::unique_ptr<hw::Trajectory> script)
@@ -64,12 +66,15 @@ class DeviceRowsReplay final : public hw::Device, public hw::SampleClock, public
     s.gimbal = rows_.gimbal[n];
     s.buttons = rows_.buttons[n];
     time_ = rows_.device_time[n];
+    row_ = n;
     overrun_ = rows_.overrun[n];
     return s;
   }
   hw::DeviceLimits limits() const override { return limits_; }
   std::string describe() const override { return "replay of " + source_; }
   double sample_time() const override { return time_; }
+  std::int64_t sample_sequence() const override { return rows_.sequence[row_]; }
+  std::int64_t new_samples() const override { return rows_.new_samples[row_]; }
   bool recorded_overrun() const override { return overrun_; }
 
  protected:
@@ -81,6 +86,7 @@ class DeviceRowsReplay final : public hw::Device, public hw::SampleClock, public
   std::string source_;
   std::unique_ptr<hw::Trajectory> script_;
   double time_ = 0.0;
+  std::size_t row_ = 0;   // the last row read
   bool overrun_ = false;
 };
 
@@ -116,6 +122,18 @@ RecordedDeviceRows read_device_rows(const std::string& trace, const std::string&
     r.overrun.push_back(overrun.values[i] != 0.0);
   }
   r.device_time = time.values;
+  // The device's sample numbering (-1 where the trace predates the columns).
+  for (auto [column, out] : {std::pair{"/sequence", &r.sequence}, std::pair{"/new_samples", &r.new_samples}}) {
+    recordings::Dataset d;
+    try {
+      d = recordings::read_dataset(trace, table + column);
+    } catch (const recordings::TraceError&) {   // no such column: the table's others were read
+      out->assign(n, -1);
+      continue;
+    }
+    if (d.values.size() != n) throw ReplayError(trace + ": " + table + ": columns of different lengths");
+    for (double v : d.values) out->push_back(static_cast<std::int64_t>(v));
+  }
   r.mapped = parse_mapping(recordings::read_string_attribute(trace, table, "mapping"), r.mapping);
   r.limits.max_force = std::strtod(recordings::read_string_attribute(trace, table, "max_force").c_str(), nullptr);
   return r;

@@ -16,6 +16,7 @@
 #include "graspsim/engine/state_hash.hpp"
 #include "graspsim/hw/mapped_device.hpp"
 #include "graspsim/hw/sample_clock.hpp"
+#include "graspsim/hw/sample_counter.hpp"
 #include "graspsim/hw/scripted_finger.hpp"
 #include "graspsim/recordings/trace_recorder.hpp"
 #include "graspsim/recordings/trace_writer.hpp"
@@ -126,6 +127,8 @@ struct DeviceColumns {
   std::size_t finger;   // Model::fingers index
   recordings::TraceTable* table;
   std::size_t tick, time, device_time, position, gimbal, buttons, force, overrun;   // row offsets
+  std::size_t sequence = 0, new_samples = 0;                                         // row offsets
+  const hw::SampleCounter* counter = nullptr;   // the device's sample numbering, if it has one
 };
 
 std::string mapping_text(const hw::WorkspaceMapping& m) {
@@ -136,7 +139,7 @@ std::string mapping_text(const hw::WorkspaceMapping& m) {
 }
 
 DeviceColumns device_columns(recordings::TraceWriter& writer, std::size_t finger, const std::string& name,
-                             const hw::Device& device, std::size_t block_rows) {
+                             hw::Device& device, std::size_t block_rows) {
   using recordings::DType;
   DeviceColumns c{finger, &writer.table("devices/" + name, block_rows), 0, 0, 0, 0, 0, 0, 0, 0};
   recordings::TraceTable& t = *c.table;
@@ -148,6 +151,11 @@ DeviceColumns device_columns(recordings::TraceWriter& writer, std::size_t finger
   c.buttons = t.add_column("buttons", 1, DType::kInt64, "1");
   c.force = t.add_column("force", 3, DType::kFloat64, "N");
   c.overrun = t.add_column("overrun", 1, DType::kInt8, "1");
+  // Gaps and holds at the device's own rate (hw::SampleCounter; -1 for a device without one).
+  c.sequence = t.add_column("sequence", 1, DType::kInt64, "1");
+  c.new_samples = t.add_column("new_samples", 1, DType::kInt64, "1");
+  auto* inner = dynamic_cast<hw::MappedDevice*>(&device);
+  c.counter = dynamic_cast<const hw::SampleCounter*>(inner ? &inner->inner() : &device);
   t.set_attribute(".", "device", device.describe());
   const auto* mapped = dynamic_cast<const hw::MappedDevice*>(&device);
   t.set_attribute(".", "mapping", mapped ? mapping_text(mapped->mapping()) : "identity (device frame = world)");
@@ -348,6 +356,8 @@ RunResult run_scenario(const scripting::Scenario& scenario, const RunOptions& op
         }
         row[c.buttons] = static_cast<double>(raw->buttons);
         row[c.overrun] = (recorded ? recorded->recorded_overrun() : pace.overrun) ? 1.0 : 0.0;
+        row[c.sequence] = c.counter ? static_cast<double>(c.counter->sample_sequence()) : -1.0;
+        row[c.new_samples] = c.counter ? static_cast<double>(c.counter->new_samples()) : -1.0;
       }
       if (recorder) {
         recorder->record(record, rendered, input, sim.state());

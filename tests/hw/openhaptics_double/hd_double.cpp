@@ -237,7 +237,7 @@ void hdGetIntegerv(HDenum pname, HDint* params) {
       if (!d->in_frame) violation("HD_CURRENT_BUTTONS read outside a frame");
       params[0] = d->device->buttons;
       return;
-    case HD_UPDATE_RATE: params[0] = 1000; return;
+    case HD_UPDATE_RATE: params[0] = d->device->update_rate; return;
     default: raise(HD_INVALID_ENUM);
   }
 }

@@ -22,6 +22,7 @@ struct FakeDevice {
   double max_force = 8.5;             // N: HD_NOMINAL_MAX_FORCE
   double max_continuous_force = 1.4;  // N: HD_NOMINAL_MAX_CONTINUOUS_FORCE
   double max_stiffness = 3.5;         // N/mm: HD_NOMINAL_MAX_STIFFNESS
+  int update_rate = 1000;             // Hz: HD_UPDATE_RATE (the scheduler's servo rate)
   std::string model = "PHANTOM Premium 1.5";
   HDerror frame_error = HD_SUCCESS;   // raised once at the next hdEndFrame if set
   // State and observations (set by the double).

@@ -39,14 +39,20 @@ class Device {
     output(safe);
     return safe;
   }
-  // Renders zero force: at the end of a run, on error, when the loop stalls.
-  void release() { output(Vec3::Zero()); }
+  // Renders zero force: at the end of a run, on error, when the loop stalls. Then on_release().
+  void release() {
+    output(Vec3::Zero());
+    on_release();
+  }
   virtual DeviceLimits limits() const = 0;
   virtual std::string describe() const = 0;   // for messages and the trace, e.g. "scripted"
 
  protected:
   // Sends an already clamped force to the hardware (or stores it).
   virtual void output(const Vec3& force) = 0;
+  // Called by release() after the zero force is sent: a backend re-arms its force ramp here
+  // (ForceSafety::release), so the next force after a release rises from zero again.
+  virtual void on_release() {}
 };
 
 }  // namespace graspsim::hw

@@ -48,6 +48,7 @@ class MappedDevice final : public Device {
 
  protected:
   void output(const Vec3& force) override;
+  void on_release() override { device_->release(); }   // the wrapped device re-arms its ramp too
 
  private:
   std::unique_ptr<Device> device_;

@@ -8,16 +8,28 @@
 #include <string>
 
 #include "graspsim/hw/device.hpp"
+#include "graspsim/hw/force_safety.hpp"
+#include "graspsim/hw/sample_clock.hpp"
+#include "graspsim/hw/sample_counter.hpp"
 #include "graspsim/hw/udp_protocol.hpp"
 
 namespace graspsim::hw {
+
+// The device model whose limits a UDP device gets when its spec names none: the weakest in the
+// table (Touch / Omni: 3.3 N peak, 0.88 N continuous). A UDP server cannot say what it drives;
+// a limit too low only feels weak, one too high can overheat a small device's motors.
+inline constexpr const char* kUdpDefaultModel = "touch";
+
+// Force safety for a device of model `key` (device_models.hpp): its peak and continuous force,
+// ForceSafetyConfig's defaults for the rest. Throws std::invalid_argument for an unknown key.
+ForceSafetyConfig udp_safety_of_model(const std::string& key);
 
 struct UdpDeviceConfig {
   std::string host = "127.0.0.1";   // the device server: a numeric address or a host name
   std::uint16_t port = 0;            // the device server's UDP port
   std::uint16_t local_port = 0;      // our UDP port; 0 = any free port
   double timeout_s = 0.05;           // s, graspsim time: no new sample for longer -> link lost, force 0
-  DeviceLimits limits{};             // the clamp every rendered force goes through
+  DeviceLimits limits{};             // the clamp every rendered force goes through (the finger's)
   // Lockstep (tests, `device_server --lockstep`): the server answers every datagram we send with
   // exactly one datagram, and read() first waits for the answers to all we sent, so the run
   // does not depend on timing. Off for a real device: read() never waits.
@@ -25,6 +37,11 @@ struct UdpDeviceConfig {
   double answer_wait_s = 10.0;   // s, wall clock, lockstep only: an unanswered datagram is an error
   double handshake_s = 2.0;      // s, wall clock: make_udp_device waits this long for the first
                                  //   sample (not in lockstep; 0 = do not wait)
+  // The device's own limits, applied to every force sent after the clamp above (peak, thermal
+  // continuous limit, ramp-in after start, link loss and release), on graspsim's time (the
+  // `time` of the last read). limits() is the smaller of the two peaks.
+  ForceSafetyConfig safety = udp_safety_of_model(kUdpDefaultModel);
+  std::string model = kUdpDefaultModel;   // where `safety` came from, for describe()
 };
 
 // Counts since the device was made. DEVCLI records them in the trace.
@@ -66,7 +83,7 @@ class UdpLink {
   UdpCounters counters_{};
 };
 
-class UdpDevice final : public Device {
+class UdpDevice final : public Device, public SampleClock, public SampleCounter {
  public:
   // Opens a non-blocking UDP socket bound to config.local_port, connected to host:port (so only
   // the server's datagrams are received), and sends a hello. Throws std::runtime_error naming
@@ -79,8 +96,15 @@ class UdpDevice final : public Device {
   // Drains the socket (non-blocking; in lockstep after waiting for the answers owed) and returns
   // the newest sample, in the server's frame and SI units. `tick` is not used.
   DeviceSample read(std::int64_t tick, double time) override;
-  DeviceLimits limits() const override { return config_.limits; }
-  std::string describe() const override;   // "udp 127.0.0.1:7001"
+  DeviceLimits limits() const override;    // N: min(config.limits, the safety's peak)
+  std::string describe() const override;   // "udp 127.0.0.1:7001 (touch: 3.3 N peak, 0.88 N continuous)"
+  // s: the newest sample's device time, from its datagram (0 before the first sample).
+  double sample_time() const override { return link_.has_sample() ? link_.newest().device_time : 0.0; }
+  // 1: the newest sample's sequence number (-1 before the first); samples accepted by the last read.
+  std::int64_t sample_sequence() const override {
+    return link_.has_sample() ? static_cast<std::int64_t>(link_.newest().sequence) : -1;
+  }
+  std::int64_t new_samples() const override { return new_samples_; }
 
   // Waits (wall clock, at most max_wait_s) for the first sample, resending the hello every
   // 0.25 s; true once one came. Start-up only: never called from read().
@@ -91,13 +115,17 @@ class UdpDevice final : public Device {
   const udp::Sample& newest() const { return link_.newest(); }   // with its sequence and device time
   bool has_sample() const { return link_.has_sample(); }
   const Vec3& last_force() const { return last_force_; }   // N: the force last sent (0 while lost)
+  const ForceSafety& safety() const { return safety_; }
   std::uint32_t datagrams_sent() const { return sent_; }   // hellos and forces
   std::uint16_t local_port() const { return local_port_; } // the port actually bound
   const UdpDeviceConfig& config() const { return config_; }
 
  protected:
-  // Sends a force datagram answering the newest sample: zero while the link is lost.
+  // Sends a force datagram answering the newest sample, through ForceSafety at the last read's
+  // time: zero while the link is lost (and the ramp re-armed, so force rises again after it).
   void output(const Vec3& force) override;
+  // After release()'s zero: the next force ramps in again.
+  void on_release() override { safety_.release(); }
 
  private:
   void send_hello();
@@ -107,6 +135,10 @@ class UdpDevice final : public Device {
 
   UdpDeviceConfig config_;
   UdpLink link_;
+  ForceSafety safety_;
+  double time_ = 0.0;                  // s, graspsim time of the last read: ForceSafety's clock
+  std::int64_t new_samples_ = 0;       // 1: samples the last read accepted
+  std::uint64_t received_at_read_ = 0; // 1: counters().received after the last read
   int fd_ = -1;
   std::uint16_t local_port_ = 0;
   std::uint32_t sent_ = 0;             // datagrams sent: the next one's sequence number
@@ -118,8 +150,10 @@ class UdpDevice final : public Device {
 // waited for; throws std::runtime_error "udp device HOST:PORT: no sample within S s ..." if none.
 std::unique_ptr<Device> make_udp_device(const UdpDeviceConfig& config);
 
-// Parses "HOST:PORT[,timeout=S][,local_port=N][,lockstep]" (a leading "udp:" is allowed) into a
-// config with default limits. Throws std::invalid_argument naming the spec and what is wrong.
+// Parses "HOST:PORT[,timeout=S][,local_port=N][,lockstep][,model=KEY][,max_force=N]
+// [,continuous_force=N]" (a leading "udp:" is allowed) into a config: the safety limits of model
+// KEY (default kUdpDefaultModel), then max_force / continuous_force (N) over them. Throws
+// std::invalid_argument naming the spec and what is wrong.
 UdpDeviceConfig parse_udp_spec(const std::string& spec);
 
 }  // namespace graspsim::hw
