@@ -213,6 +213,9 @@ LuaSandbox::~LuaSandbox() { lua_close(state_); }
 // Refusing (null) makes Lua collect garbage and retry once, then raise its memory error.
 void* LuaSandbox::allocate(void* self, void* block, std::size_t old_size, std::size_t new_size) {
   auto* sandbox = static_cast<LuaSandbox*>(self);
+  // Counted, not refused: an allocator may not throw through Lua (the entry points refuse).
+  if (std::this_thread::get_id() == sandbox->forbidden_thread_.load(std::memory_order_relaxed))
+    sandbox->forbidden_uses_.fetch_add(1, std::memory_order_relaxed);
   const std::size_t old_bytes = block != nullptr ? old_size : 0;
   if (new_size == 0) {
     std::free(block);
@@ -283,7 +286,15 @@ void LuaSandbox::load(std::string_view source, const std::string& path) {
   if (info.short_src != path) chunknames_.emplace_back(info.short_src, path);
 }
 
+void LuaSandbox::enter() const {
+  if (std::this_thread::get_id() != forbidden_thread_.load(std::memory_order_relaxed)) return;
+  forbidden_uses_.fetch_add(1, std::memory_order_relaxed);
+  throw ScenarioError("Lua was called on the real-time loop thread, where it may not run "
+                      "(scripting/README.md \"Threads\")");
+}
+
 void LuaSandbox::call(int nargs, int nresults, Budget budget) {
+  enter();
   ensure_stack(state_, 1);
   const int function = lua_gettop(state_) - nargs;
   lua_pushcfunction(state_, message_handler);
@@ -295,6 +306,7 @@ void LuaSandbox::call(int nargs, int nresults, Budget budget) {
 }
 
 void LuaSandbox::protect(CFunction fn, void* userdata, int nargs, int nresults) {
+  enter();
   ensure_stack(state_, 2);
   lua_pushcfunction(state_, fn);
   lua_pushlightuserdata(state_, userdata);

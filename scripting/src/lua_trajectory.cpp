@@ -15,6 +15,7 @@ LuaTrajectory::LuaTrajectory(LuaSandbox& sandbox, int function_ref, std::string 
     : sandbox_(&sandbox), function_ref_(function_ref), path_(std::move(path)), label_(std::move(label)) {}
 
 hw::TrajectorySample LuaTrajectory::sample(double t) {
+  sandbox_->enter();   // before anything touches the state (the thread guard)
   lua_State* state = sandbox_->state();
   const int top = lua_gettop(state);
   const auto where = [&] { return label_ + " trajectory at t = " + format_short(t) + " s"; };

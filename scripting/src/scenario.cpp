@@ -164,9 +164,21 @@ std::unique_ptr<hw::Trajectory> Scenario::make_trajectory(std::size_t finger) co
   if (spec.function_ref == 0) {
     return std::make_unique<hw::WaypointTrajectory>(spec.waypoints, spec.interpolation);
   }
-  return std::make_unique<detail::LuaTrajectory>(*lua_, spec.function_ref, path_,
-                                                 finger_label(finger, model_.fingers[finger].name));
+  auto lua = std::make_unique<detail::LuaTrajectory>(*lua_, spec.function_ref, path_,
+                                                     finger_label(finger, model_.fingers[finger].name));
+  if (wrapper_) return wrapper_(finger, std::move(lua));
+  return lua;
 }
+
+bool Scenario::has_lua_trajectories() const {
+  for (const TrajectorySpec& t : trajectories_)
+    if (t.function_ref != 0) return true;
+  return false;
+}
+
+void Scenario::forbid_lua_on(std::thread::id id) const { lua_->forbid_thread(id); }
+
+std::int64_t Scenario::lua_uses_on_forbidden_thread() const { return lua_->forbidden_uses(); }
 
 void Scenario::update_view(const Snapshot& now) const {
   try {
@@ -182,6 +194,7 @@ ExpectationResult Scenario::check(std::size_t expectation, const Snapshot& now,
     throw std::out_of_range("check: no expectation " + std::to_string(expectation) + " (the scenario has " +
                             std::to_string(expectations_.size()) + ")");
   }
+  lua_->enter();   // before anything touches the state (the thread guard)
   const Expectation& e = expectations_[expectation];
   const std::string label = "expect[" + std::to_string(expectation + 1) + "] '" + e.what + "'";
   lua_State* state = lua_->state();

@@ -11,6 +11,9 @@
 #include <numeric>
 #include <optional>
 #include <sstream>
+#include <thread>
+
+#include "app/script_thread.hpp"
 
 #include "graspsim/engine/simulation.hpp"
 #include "graspsim/engine/state_hash.hpp"
@@ -34,14 +37,10 @@ double seconds_since(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
 }
 
-std::string body_name(const Model& model, int body) {
-  if (body >= 0) return model.bodies[body].name;
-  return body == kFloor ? "floor" : "";
-}
-
 // What the scenario's expectation functions and the trajectories' view see, written into `s`
 // in place: after the first call, for the same model, it allocates nothing (names are assigned
-// over equal names, vectors keep their size).
+// over equal names, vectors keep their size; `touching` is assigned without a temporary, within
+// the room presize_snapshot gives it).
 void fill_snapshot(const Simulation& sim, const TickRecord& last, const std::vector<double>& slip,
                    scripting::Snapshot& s) {
   const Model& model = sim.model();
@@ -65,7 +64,9 @@ void fill_snapshot(const Simulation& sim, const TickRecord& last, const std::vec
     fs.hip = last.servo[f].hip;
     fs.force = last.servo[f].force;
     fs.god_object = last.haptic[f].god_object;
-    fs.touching = body_name(model, state.fingers[f].body);
+    const int body = state.fingers[f].body;
+    if (body >= 0) fs.touching = model.bodies[body].name;
+    else fs.touching = body == kFloor ? "floor" : "";
     fs.phase = state.fingers[f].phase;
     fs.slip = slip[f];
   }
@@ -210,6 +211,16 @@ RunResult run_scenario(const scripting::Scenario& scenario, const RunOptions& op
 
   std::vector<std::unique_ptr<hw::Device>> devices;
   std::vector<double> slip(model.fingers.size(), 0.0);
+  // Paced runs keep Lua off the loop's thread (script_thread.hpp, README.md "Devices"): Lua
+  // trajectories are sampled ahead on a script thread (declared after the devices, so it stops
+  // before they go), expectations are checked after the loop from snapshots the loop copied at
+  // their ticks, and the loop's thread may not enter Lua at all (Scenario::forbid_lua_on).
+  const bool paced = options.pacer != nullptr;
+  std::optional<ScriptThread> script;
+  std::vector<std::pair<std::int64_t, std::size_t>> due;   // (tick, expectation) in due order
+  std::size_t next_due = 0;
+  std::vector<scripting::Snapshot> due_snapshots;   // paced: the snapshot at each due tick
+  scripting::Snapshot initial;                      // the snapshot at t = 0
   // Zero force on every device, even if one of them fails to take it (its error is kept for
   // the result when the run has none: a device that may still push is worth reporting).
   std::string release_error;
@@ -233,12 +244,30 @@ RunResult run_scenario(const scripting::Scenario& scenario, const RunOptions& op
   bool realtime = false;   // this thread is SCHED_FIFO (until the loop ends)
   try {
     std::ostringstream device_list;
-    for (std::size_t f = 0; f < model.fingers.size(); ++f) {
-      if (options.make_device) devices.push_back(options.make_device(f));
-      else devices.push_back(std::make_unique<hw::ScriptedFinger>(scenario.make_trajectory(f),
-                                                                  scenario.fingers()[f].limits));
-      device_list << model.fingers[f].name << ": " << devices.back()->describe()
-                  << " (max force " << devices.back()->limits().max_force << " N)\n";
+    {
+      // Paced: every Lua trajectory a device asks for is fed by the script thread.
+      struct Unwrap {
+        const scripting::Scenario& s;
+        ~Unwrap() { s.set_trajectory_wrapper({}); }
+      } unwrap{scenario};
+      if (paced && scenario.has_lua_trajectories()) {
+        ScriptThreadOptions so;
+        so.rate_servo = model.rates.servo;
+        so.physics_divisor = divisors(model.rates).physics;
+        so.end_tick = static_cast<std::int64_t>(std::llround(scenario.duration() * model.rates.servo));
+        so.view = scenario.uses_view();
+        so.wait_for_samples = options.wait_for_script;
+        script.emplace(scenario, so);
+        scenario.set_trajectory_wrapper(
+            [&script](std::size_t, std::unique_ptr<hw::Trajectory> lua) { return script->wrap(std::move(lua)); });
+      }
+      for (std::size_t f = 0; f < model.fingers.size(); ++f) {
+        if (options.make_device) devices.push_back(options.make_device(f));
+        else devices.push_back(std::make_unique<hw::ScriptedFinger>(scenario.make_trajectory(f),
+                                                                    scenario.fingers()[f].limits));
+        device_list << model.fingers[f].name << ": " << devices.back()->describe()
+                    << " (max force " << devices.back()->limits().max_force << " N)\n";
+      }
     }
     writer.set_attribute("devices", device_list.str());
     std::vector<hw::DeviceSample> samples(devices.size());   // this tick's, as read (world)
@@ -262,7 +291,6 @@ RunResult run_scenario(const scripting::Scenario& scenario, const RunOptions& op
     const std::int64_t run_ticks = options.max_ticks >= 0 ? std::min(ticks, options.max_ticks) : ticks;
 
     // Expectations in the order they fall due: (tick, index), so ties keep the scenario's order.
-    std::vector<std::pair<std::int64_t, std::size_t>> due;
     for (std::size_t i = 0; i < scenario.expectations().size(); ++i) {
       const double at = scenario.expectations()[i].at;
       const std::int64_t tick = at < 0.0 ? ticks : std::min<std::int64_t>(ticks, std::llround(at * model.rates.servo));
@@ -271,8 +299,6 @@ RunResult run_scenario(const scripting::Scenario& scenario, const RunOptions& op
     std::sort(due.begin(), due.end());
     for (const auto& e : scenario.expectations())
       result.expectations.push_back({e.what, false, "not checked: the run stopped before it was due"});
-    std::size_t next_due = 0;
-    scripting::Snapshot initial;
     // The read-only view trajectory functions get: the state as the last physics tick left it
     // (before the first tick: the initial state, fingers at zero and free). Updated only when a
     // physics tick ran, and only if some trajectory function takes it.
@@ -282,10 +308,27 @@ RunResult run_scenario(const scripting::Scenario& scenario, const RunOptions& op
       fill_snapshot(sim, record, slip, view_state);
       scenario.update_view(view_state);
     }
+    if (paced) {
+      // Room for every snapshot the loop will copy, so that copying allocates nothing.
+      scripting::Snapshot prototype;
+      fill_snapshot(sim, record, slip, prototype);
+      presize_snapshot(prototype);
+      due_snapshots.assign(due.size(), prototype);
+      for (scripting::Snapshot& s : due_snapshots) presize_snapshot(s);
+      initial = prototype;
+      presize_snapshot(initial);
+      if (script && script->has_feeds()) {
+        if (view) script->prepare_views(prototype);
+        script->start();
+      }
+    }
+    const bool script_feeds = script && script->has_feeds();
     const auto check_due = [&](std::int64_t tick) {
       while (next_due < due.size() && due[next_due].first == tick) {
         const std::size_t i = due[next_due].second;
-        result.expectations[i] = scenario.check(i, snapshot(sim, record, slip), initial);
+        // Paced: only the copy here; the check runs after the loop, off the real-time thread.
+        if (paced) fill_snapshot(sim, record, slip, due_snapshots[next_due]);
+        else result.expectations[i] = scenario.check(i, snapshot(sim, record, slip), initial);
         ++next_due;
       }
     };
@@ -296,6 +339,7 @@ RunResult run_scenario(const scripting::Scenario& scenario, const RunOptions& op
       // The writer thread exists already (the TraceWriter started it), so only this thread
       // becomes real-time; the CLI has warned if the system does not allow it.
       if (options.realtime) realtime = enter_realtime().empty();
+      scenario.forbid_lua_on(std::this_thread::get_id());
       options.pacer->start();
     }
     for (std::int64_t n = 0; n < run_ticks; ++n) {
@@ -308,7 +352,8 @@ RunResult run_scenario(const scripting::Scenario& scenario, const RunOptions& op
       if (n == 0) {
         // Before the first step no finger record exists yet: a finger is where its device is.
         for (std::size_t f = 0; f < devices.size(); ++f) record.servo[f].hip = record.haptic[f].god_object = input.fingers[f].hip;
-        initial = snapshot(sim, record, slip);
+        if (paced) fill_snapshot(sim, record, slip, initial);
+        else initial = snapshot(sim, record, slip);
       }
       check_due(n);
       sim.step(input, record);
@@ -387,9 +432,20 @@ RunResult run_scenario(const scripting::Scenario& scenario, const RunOptions& op
         for (std::size_t f = 0; f < slip.size(); ++f) slip[f] += record.haptic[f].slip;
       }
       result.physics_ticks += record.physics_ran;
-      if (view && record.physics_ran) {
+      if (view && record.physics_ran && !paced) {
         fill_snapshot(sim, record, slip, view_state);
         scenario.update_view(view_state);
+      }
+      if (script_feeds) {
+        // Paced: the view goes to the script thread (a copy into a preallocated slot), then the
+        // tick is done: the script thread may compute the sample that needed it.
+        if (view && record.physics_ran) {
+          if (scripting::Snapshot* v = script->view_slot()) {
+            fill_snapshot(sim, record, slip, *v);
+            script->commit_view(n);
+          }
+        }
+        script->tick_done(n);
       }
       // Paced (a hand on a device): Ctrl-C is seen at the next tick, not up to a second later.
       if (options.pacer && options.interrupt && options.interrupt->load()) {
@@ -409,7 +465,10 @@ RunResult run_scenario(const scripting::Scenario& scenario, const RunOptions& op
         }
       }
     }
-    if (run_ticks == 0) initial = snapshot(sim, record, slip);
+    if (run_ticks == 0) {
+      if (paced) fill_snapshot(sim, record, slip, initial);
+      else initial = snapshot(sim, record, slip);
+    }
     check_due(run_ticks);
   } catch (const std::exception& e) {
     result.error = e.what();
@@ -421,6 +480,26 @@ RunResult run_scenario(const scripting::Scenario& scenario, const RunOptions& op
   if (options.pacer) {
     result.pacing = options.pacer->summary();
     result.overruns = options.pacer->overruns();
+  }
+  if (paced) {
+    // The loop is over and this thread ordinary again: Lua may run here once the script thread
+    // has stopped. The expectations that fell due are checked now, in due order, from the
+    // snapshots the loop copied; a script error stops them as it stops an unpaced run.
+    if (script) script->stop();
+    scenario.forbid_lua_on(std::thread::id{});
+    if (script && script->has_feeds()) {
+      result.script_holds = script->holds();
+      result.pacing += "; " + script->summary();
+      writer.set_attribute("script_thread", script->summary());
+    }
+    try {
+      for (std::size_t k = 0; k < next_due; ++k) {
+        const std::size_t i = due[k].second;
+        result.expectations[i] = scenario.check(i, due_snapshots[k], initial);
+      }
+    } catch (const std::exception& e) {
+      if (result.error.empty()) result.error = e.what();
+    }
   }
   result.wall = seconds_since(start);
 

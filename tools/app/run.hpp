@@ -53,6 +53,11 @@ struct RunOptions {
   // real device). Only what devices render changes, never the engine; root attribute
   // `force_ramp`, which a replay applies again.
   double force_ramp = 0.0;
+  // Tests only: in a paced run, the loop waits for a Lua trajectory sample the script thread can
+  // still compute instead of holding the last one (ScriptThreadOptions::wait_for_samples), so a
+  // paced run on a fake clock, which outruns any thread, gets every sample. Never with a hand on
+  // a device.
+  bool wait_for_script = false;
 };
 
 // A device whose samples carry their recorded overrun flag (a replay of /devices rows): the
@@ -74,6 +79,9 @@ struct RunResult {
   bool interrupted = false;
   std::string pacing;        // with a pacer: its summary (overruns of how many ticks, worst lateness)
   std::int64_t overruns = 0; // with a pacer: servo ticks that missed their deadline
+  // With a pacer and Lua trajectories: samples the loop held because the script thread's ring
+  // for that trajectory ran dry (tools/app/script_thread.hpp; also in `pacing`).
+  std::int64_t script_holds = 0;
   bool passed() const;      // no error and every expectation met
 };
 

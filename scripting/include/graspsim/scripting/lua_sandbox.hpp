@@ -7,9 +7,11 @@
 // One state, one thread: nothing here may be used from two threads at once.
 #pragma once
 
+#include <atomic>
 #include <cstddef>
 #include <cstdint>
 #include <string>
+#include <thread>
 #include <string_view>
 #include <utility>
 #include <vector>
@@ -74,6 +76,16 @@ class LuaSandbox {
 
   std::size_t memory_used() const { return used_bytes_; }   // bytes
 
+  // Thread guard (scripting/README.md "Threads"): while a thread is forbidden (a paced run's
+  // real-time loop), every entry into this state from it is refused before the state is touched
+  // (enter() throws ScenarioError) and every allocation made on it is counted. Both are one
+  // relaxed atomic load and a compare: always on, in Release too. std::thread::id{} lifts it.
+  void forbid_thread(std::thread::id id) { forbidden_thread_.store(id, std::memory_order_relaxed); }
+  // Throws ScenarioError when called on the forbidden thread (and counts the attempt).
+  void enter() const;
+  // Entries and allocations refused or seen on a forbidden thread since the state was made.
+  std::int64_t forbidden_uses() const { return forbidden_uses_.load(std::memory_order_relaxed); }
+
  private:
   static void* allocate(void* self, void* block, std::size_t old_size, std::size_t new_size);
   static void count_hook(lua_State* state, lua_Debug* debug);
@@ -90,6 +102,8 @@ class LuaSandbox {
   bool hook_every_instruction_ = false;   // the budget ran out: the hook now fires every time
   // Lua shortens long chunk names to "...tail"; messages get the full path back.
   std::vector<std::pair<std::string, std::string>> chunknames_;   // (short, full)
+  std::atomic<std::thread::id> forbidden_thread_{};   // std::thread::id{}: none
+  mutable std::atomic<std::int64_t> forbidden_uses_{0};
 };
 
 }  // namespace graspsim::scripting

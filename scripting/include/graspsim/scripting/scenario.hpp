@@ -4,9 +4,11 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <stdexcept>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "graspsim/engine/model.hpp"
@@ -109,6 +111,21 @@ class Scenario {
   // it runs are thrown as ScenarioError with file:line and a traceback.
   std::unique_ptr<hw::Trajectory> make_trajectory(std::size_t finger) const;
 
+  // Paced runs (tools/app/script_thread.hpp, scripting/README.md "Threads"): while set,
+  // make_trajectory hands every Lua function trajectory (waypoints need no Lua) to the wrapper,
+  // with its finger, and returns what the wrapper returns: a trajectory fed by a script thread.
+  // An empty function removes it. Not thread-safe: set it before devices are built.
+  using TrajectoryWrapper =
+      std::function<std::unique_ptr<hw::Trajectory>(std::size_t finger, std::unique_ptr<hw::Trajectory> lua)>;
+  void set_trajectory_wrapper(TrajectoryWrapper wrapper) const { wrapper_ = std::move(wrapper); }
+  // True when some trajectory of a finger is a Lua function.
+  bool has_lua_trajectories() const;
+  // The thread guard (LuaSandbox::forbid_thread): from now on any use of this scenario's Lua state
+  // from thread `id` throws and is counted; std::thread::id{} lifts it.
+  void forbid_lua_on(std::thread::id id) const;
+  // Entries into Lua and Lua allocations seen on a forbidden thread so far (0 in a correct run).
+  std::int64_t lua_uses_on_forbidden_thread() const;
+
   // True when some trajectory function takes a second parameter (or ...): only then does the
   // run loop need to keep the view up to date.
   bool uses_view() const { return uses_view_; }
@@ -139,6 +156,7 @@ class Scenario {
   };
   std::vector<TrajectorySpec> trajectories_;
   std::unique_ptr<LuaSandbox> lua_;   // owns the Lua state the functions live in
+  mutable TrajectoryWrapper wrapper_;   // set by a paced run while it builds devices
   friend class ScenarioBuilder;
 };
 
