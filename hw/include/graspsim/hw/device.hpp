@@ -40,13 +40,19 @@ class Device {
     return safe;
   }
   // Renders zero force: at the end of a run, on error, when the loop stalls.
-  void release() { output(Vec3::Zero()); }
+  void release() {
+    output(Vec3::Zero());
+    on_release();
+  }
   virtual DeviceLimits limits() const = 0;
   virtual std::string describe() const = 0;   // for messages and the trace, e.g. "scripted"
 
  protected:
   // Sends an already clamped force to the hardware (or stores it).
   virtual void output(const Vec3& force) = 0;
+  // Called by release() after the zero force was sent: a device that ramps its force in
+  // (ForceSafety) restarts the ramp here.
+  virtual void on_release() {}
 };
 
 }  // namespace graspsim::hw
