@@ -34,7 +34,7 @@ struct SimPhantomConfig {
   double hand_correction_time = 0.3;   // s: tau_c, > m / (b + b_h) for stability (Routh)
   // Anti-windup: the correction never makes the hand push harder than this, k_h |u| <= F_h
   // (against a wall, a workspace stop or a device at its force limit). ESTIMATE: above the
-  // 1-10 N of precision grips (Westling & Johansson 1984), well under a maximal pinch.
+  // 1-10 N of precision grips (Westling & Johansson 1984, from memory), well under a maximal pinch.
   double hand_max_force = 20.0;        // N: F_h
   // Stylus integration steps per device tick (>= 1). Semi-implicit Euler's position leads by
   // half a step, which shortens the ZOH's effective delay from T/2 to (T - h)/2 and moves the
