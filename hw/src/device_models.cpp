@@ -16,7 +16,7 @@ constexpr double kMm = 1e-3;   // m per mm
 const std::array<DeviceModel, 4> kModels = {{
     {
         "premium-1.5", "Phantom Premium 1.5",
-        Vec3{381 * kMm, 267 * kMm, 191 * kMm},   // data sheet: 381 W x 267 H x 191 D mm
+        Vec3{381 * kMm, 191 * kMm, 267 * kMm},   // data sheet: 381 W x 267 H x 191 D mm (x W, y D, z H)
         8.5,              // data sheet: maximum exertable force 8.5 N (1.9 lbf)
         1.4,              // data sheet: continuous exertable force (24 h) 1.4 N (0.3 lbf)
         3.5e3,            // data sheet: stiffness 3.5 N/mm (20 lb/in)
@@ -28,7 +28,7 @@ const std::array<DeviceModel, 4> kModels = {{
     },
     {
         "premium-1.5-hf", "Phantom Premium 1.5 High Force",
-        Vec3{381 * kMm, 267 * kMm, 191 * kMm},   // data sheet: 381 W x 267 H x 191 D mm
+        Vec3{381 * kMm, 191 * kMm, 267 * kMm},   // data sheet: 381 W x 267 H x 191 D mm (x W, y D, z H)
         37.5,             // data sheet: maximum exertable force 37.5 N (8.4 lbf)
         6.2,              // data sheet: continuous exertable force (24 h) 6.2 N (1.4 lbf)
         3.5e3,            // data sheet: stiffness 3.5 N/mm
@@ -40,7 +40,7 @@ const std::array<DeviceModel, 4> kModels = {{
     },
     {
         "omni", "Phantom Omni",
-        Vec3{160 * kMm, 120 * kMm, 70 * kMm},    // data sheet: > 160 W x 120 H x 70 D mm
+        Vec3{160 * kMm, 70 * kMm, 120 * kMm},    // data sheet: > 160 W x 120 H x 70 D mm (x W, y D, z H)
         3.3,              // data sheet: maximum exertable force 3.3 N
         0.88,             // data sheet: continuous exertable force (24 h) > 0.88 N
         1.02e3,           // data sheet: X 1.26, Y 2.31, Z 1.02 N/mm; the lowest (Z) is used
@@ -52,7 +52,7 @@ const std::array<DeviceModel, 4> kModels = {{
     },
     {
         "touch", "Touch",
-        Vec3{160 * kMm, 120 * kMm, 70 * kMm},    // data sheet: > 160 W x 120 H x 70 D mm
+        Vec3{160 * kMm, 70 * kMm, 120 * kMm},    // data sheet: > 160 W x 120 H x 70 D mm (x W, y D, z H)
         3.3,              // data sheet: maximum exertable force 3.3 N
         0.88,             // data sheet: continuous exertable force (24 h) > 0.88 N
         1.02e3,           // data sheet: X 1.26, Y 2.31, Z 1.02 N/mm; the lowest (Z) is used

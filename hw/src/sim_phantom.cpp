@@ -3,7 +3,9 @@
 // Per device tick n -> n+1 (period T = 1 / rate), with the motor force F_m = ForceSafety::output(t_n)
 // held over the tick (zero-order hold) and the hand target moving linearly from x_h(t_n) to
 // x_h(t_{n+1}) (velocity v_h), the tip is integrated with N = substeps steps of h = T / N:
-//   F      = k_h (x_h - x) + b_h (v_h - v) + F_m                  (explicit)
+//   F      = k_h (x_h + u - x) + b_h (v_h - v) + F_m              (explicit)
+//   u      = u + h (x_h - x) / tau_c, then |u| <= F_h / k_h       (the hand's voluntary
+//            correction, explicit, clamped: anti-windup)
 //   v'     = (v + h F / m) / (1 + h b / m)                         (viscous damping implicit)
 //   v''    = 0 if |v'| <= h mu / m, else v' (1 - (h mu / m) / |v'|)   (Coulomb, stick when the
 //            friction impulse can stop the tip within the step: no chatter)
@@ -68,6 +70,24 @@ SimPhantom::SimPhantom(const SimPhantomConfig& config, std::unique_ptr<Trajector
   require(config.substeps >= 1 && config.substeps <= 1000,
           "substeps must be in [1, 1000], got " + std::to_string(config.substeps));
   require(config.workspace_center.allFinite(), "workspace_center must be finite (m)");
+  require(!std::isnan(config.hand_correction_time) && config.hand_correction_time > 0.0,
+          "hand_correction_time must be > 0 (s; inf = no correction), got " +
+              std::to_string(config.hand_correction_time));
+  require(std::isfinite(config.hand_max_force) && config.hand_max_force > 0.0,
+          "hand_max_force must be finite and > 0 (N), got " + std::to_string(config.hand_max_force));
+  // The hand-stylus loop m x'' = -k_h (x - u) - (b + b_h) x', u' = -x / tau_c has the
+  // characteristic polynomial m tau s^3 + (b + b_h) tau s^2 + k_h tau s + k_h: Routh-stable iff
+  // (b + b_h) tau_c > m.
+  require(config.hand_stiffness == 0.0 || std::isinf(config.hand_correction_time) ||
+              (b_ + config.hand_damping) * config.hand_correction_time > model_.tip_mass,
+          "hand_correction_time must exceed m / (b + b_h) = " +
+              std::to_string(model_.tip_mass / (b_ + config.hand_damping)) +
+              " s (the hand's correction would be unstable), got " +
+              std::to_string(config.hand_correction_time));
+  correction_rate_ = std::isinf(config.hand_correction_time) || config.hand_stiffness == 0.0
+                         ? 0.0
+                         : 1.0 / config.hand_correction_time;
+  u_max_ = config.hand_max_force / config.hand_stiffness;   // inf when k_h = 0 (u unused then)
   // Explicit hand spring: stable for h sqrt(k_h / m) < 2; ask for a wide margin.
   const double h = period_ / config.substeps;
   require(h * std::sqrt(config.hand_stiffness / model_.tip_mass) < 0.5,
@@ -89,6 +109,10 @@ SimPhantom::SimPhantom(const SimPhantomConfig& config, std::unique_ptr<Trajector
 std::string SimPhantom::describe() const {
   return std::string("sim-phantom (") + model_.name + ", " +
          std::to_string(static_cast<long long>(std::llround(config_.device_rate_hz))) + " Hz)";
+}
+
+Vec3 SimPhantom::hand_force() const {
+  return config_.hand_stiffness * (hand_now_.position + u_ - x_);
 }
 
 Vec3 SimPhantom::encoder() const {
@@ -115,7 +139,12 @@ void SimPhantom::step() {
   const double stop = h * mu_ / m;   // m/s: friction's speed change per step
   for (int s = 0; s < n; ++s) {
     const Vec3 xh = xh0 + vh * (h * s);
-    const Vec3 f = config_.hand_stiffness * (xh - x_) + config_.hand_damping * (vh - v_) + motor_;
+    const Vec3 f = config_.hand_stiffness * (xh + u_ - x_) + config_.hand_damping * (vh - v_) + motor_;
+    if (correction_rate_ > 0.0) {
+      u_ += (h * correction_rate_) * (xh - x_);
+      const double un = u_.norm();
+      if (un > u_max_) u_ *= u_max_ / un;   // anti-windup: the hand pushes at most F_h
+    }
     Vec3 v = (v_ + (h / m) * f) / (1.0 + h * b_ / m);
     const double speed = v.norm();
     v = speed <= stop ? Vec3::Zero() : Vec3(v * (1.0 - stop / speed));

@@ -12,7 +12,8 @@ namespace graspsim::hw {
 struct DeviceModel {
   const char* key = "";              // short name for the command line, e.g. "premium-1.5"
   const char* name = "";             // vendor's name, e.g. "Phantom Premium 1.5"
-  Vec3 workspace{0.0, 0.0, 0.0};     // m: width x height x depth of the usable box (device x, y, z)
+  Vec3 workspace{0.0, 0.0, 0.0};     // m: usable box along the device frame's x (width, right), y (depth,
+                                     // away from the user), z (height, up): the OpenHaptics backend's frame
   double peak_force = 0.0;           // N: nominal maximum exertable force (at the nominal position)
   double continuous_force = 0.0;     // N: continuous exertable force (24 h)
   double stiffness = 0.0;            // N/m: stiffness of the device (lowest axis where given per axis)

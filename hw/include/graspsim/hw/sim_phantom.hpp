@@ -1,6 +1,8 @@
 // The simulated Phantom, `sim-phantom`: a stylus tip (point mass with viscous damping and Coulomb
-// backdrive friction, per the device model table) held by a scripted hand, a spring-damper
-// pulling it toward the finger's trajectory. The device runs at its own rate with zero-order
+// backdrive friction, per the device model table) held by a scripted hand: a spring-damper (the
+// hand's impedance) pulling it toward the finger's trajectory, whose rest point the person
+// slowly moves until the tip is where they intend (a voluntary correction, integral action on
+// the position error, bounded). The device runs at its own rate with zero-order
 // hold of the rendered force across its ticks, quantises its position to encoder counts and
 // stops at the workspace limits; the rendered force goes through ForceSafety. Deterministic:
 // no clock, the state advances only in read(). hw/README.md, "Simulated Phantom", has the laws.
@@ -25,6 +27,15 @@ struct SimPhantomConfig {
   // and 1-4 N s/m depending on grip force); mid-range values.
   double hand_stiffness = 300.0;       // N/m: k_h, spring from the stylus to the trajectory
   double hand_damping = 2.0;           // N s/m: b_h, on the velocity relative to the trajectory
+  // The voluntary correction: the hand's rest point is x_h + u with du/dt = (x_h - x) / tau_c,
+  // so in steady state the tip is at the trajectory whatever force it meets (hw/README.md,
+  // "Simulated Phantom"). tau_c: ESTIMATE, a few hundred ms, slower than a visually guided
+  // correction's latency (about 0.2 s); +inf = no correction (the pure impedance hand).
+  double hand_correction_time = 0.3;   // s: tau_c, > m / (b + b_h) for stability (Routh)
+  // Anti-windup: the correction never makes the hand push harder than this, k_h |u| <= F_h
+  // (against a wall, a workspace stop or a device at its force limit). ESTIMATE: above the
+  // 1-10 N of precision grips (Westling & Johansson 1984, from memory), well under a maximal pinch.
+  double hand_max_force = 20.0;        // N: F_h
   // Stylus integration steps per device tick (>= 1). Semi-implicit Euler's position leads by
   // half a step, which shortens the ZOH's effective delay from T/2 to (T - h)/2 and moves the
   // sampled-wall stability bound from 2b/T to 2b/(T - h): 50 keeps that bias at 2 %.
@@ -59,11 +70,18 @@ class SimPhantom final : public Device {
   const Vec3& tip_position() const { return x_; }    // m: true tip position (not quantised)
   const Vec3& tip_velocity() const { return v_; }    // m/s: tip velocity
   const Vec3& motor_force() const { return motor_; } // N: force the motors applied in the last device tick
+  const Vec3& hand_offset() const { return u_; }     // m: u, the correction of the hand's rest point
+  Vec3 hand_force() const;   // N: the hand spring's force on the tip now, k_h (x_h + u - x) (no damper)
+  const Vec3& workspace_min() const { return lo_; }  // m: the workspace box's lower corner (hand frame)
+  const Vec3& workspace_max() const { return hi_; }  // m: its upper corner
   double damping() const { return b_; }              // N s/m: b in use
   double friction() const { return mu_; }             // N: mu in use
 
  protected:
   void output(const Vec3& force) override;
+  // After Device::release() has sent the zero force: the force limit ramps in again from zero
+  // at the next render (ForceSafety::release), as after a stall.
+  void on_release() override { safety_.release(); }
 
  private:
   void step();                   // one device tick
@@ -84,6 +102,9 @@ class SimPhantom final : public Device {
   Vec3 x_{0.0, 0.0, 0.0};        // m
   Vec3 v_{0.0, 0.0, 0.0};        // m/s
   Vec3 motor_{0.0, 0.0, 0.0};    // N
+  Vec3 u_{0.0, 0.0, 0.0};        // m: the hand's correction (its rest point is x_h + u)
+  double u_max_ = 0.0;           // m: F_h / k_h, the bound on |u| (inf when k_h = 0)
+  double correction_rate_ = 0.0; // 1/s: 1 / tau_c (0 = none)
   TrajectorySample hand_now_;    // the hand at the current device tick
   DeviceSample sample_;          // the reading at the current device tick
 };
