@@ -115,8 +115,8 @@ DeviceRegistry default_registry() {
   // and waits for us: nobody's hand is on it in real time, so the run is not paced, and a slow
   // moment of the machine cannot stop it (it did, with a 20 ms stall on a shared VM).
   r.add({"udp", "udp:HOST:PORT", true, true, make_udp,
-         [](const std::string& arg) { return hw::parse_udp_spec(arg).lockstep; }});
-  r.add({"phantom", "phantom:NAME", true, true, make_phantom});
+         [](const std::string& arg) { return hw::parse_udp_spec(arg).lockstep; }, false});
+  r.add({"phantom", "phantom:NAME", true, true, make_phantom, {}, false});
   return r;
 }
 
@@ -195,6 +195,7 @@ DevicePlan plan_devices(const scripting::Scenario& scenario, const std::vector<s
       }
     }
     plan.real.push_back(real);
+    plan.script_alongside.push_back(!kind->runs_script);
   }
   return plan;
 }

@@ -53,6 +53,10 @@ struct DeviceKind {
   // `udp:...,lockstep`): true for such a spec, whose device then counts as not real (the run is
   // not paced: the peer answers every datagram, so wall time decides nothing).
   std::function<bool(const std::string& arg)> waits_for_graspsim = {};
+  // Whether the device runs the finger's script itself (scripted: it is the script; replay: it
+  // runs it alongside; sim-phantom: the hand follows it). false (udp, phantom): the run loop runs
+  // it alongside (RunOptions::script_alongside).
+  bool runs_script = true;
 };
 
 class DeviceRegistry {
@@ -80,6 +84,8 @@ struct DevicePlan {
   bool any_real() const;
   // Fingers whose device is not "scripted": their samples go to /devices/<finger> in the trace.
   std::vector<bool> recorded() const;
+  // Fingers whose device does not run the finger's script (DeviceKind::runs_script false).
+  std::vector<bool> script_alongside;
 };
 
 // `options` are the --device values "FINGER=SPEC" in the order given. Throws DeviceError for a

@@ -271,6 +271,10 @@ RunResult run_scenario(const scripting::Scenario& scenario, const RunOptions& op
     }
     writer.set_attribute("devices", device_list.str());
     std::vector<hw::DeviceSample> samples(devices.size());   // this tick's, as read (world)
+    // The scripts of fingers whose device does not run them (RunOptions::script_alongside).
+    std::vector<std::unique_ptr<hw::Trajectory>> side_scripts(devices.size());
+    for (std::size_t f = 0; f < options.script_alongside.size() && f < devices.size(); ++f)
+      if (options.script_alongside[f]) side_scripts[f] = scenario.make_trajectory(f);
 
     Simulation& sim = sim_holder.emplace(model);
     std::optional<recordings::TraceRecorder> recorder;
@@ -345,6 +349,7 @@ RunResult run_scenario(const scripting::Scenario& scenario, const RunOptions& op
     for (std::int64_t n = 0; n < run_ticks; ++n) {
       const double t = sim.time();
       for (std::size_t f = 0; f < devices.size(); ++f) {
+        if (side_scripts[f]) side_scripts[f]->sample(t);   // for what the script keeps; output unused
         samples[f] = devices[f]->read(n, t);
         input.fingers[f].hip = samples[f].position;
         input.fingers[f].gimbal = samples[f].gimbal;

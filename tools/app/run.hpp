@@ -41,6 +41,12 @@ struct RunOptions {
   // Devices (README.md "Devices"): fingers whose every device sample goes to /devices/<finger>
   // (empty: none; the fingers of non-scripted devices, DevicePlan::recorded()).
   std::vector<bool> record_devices;
+  // Fingers whose device does not run the finger's script itself (udp, phantom; empty: none,
+  // DevicePlan::script_alongside()): the run evaluates that script at every tick before the
+  // device is read, its output discarded, as a replay: device does, so a script that watches the
+  // run (or draws from math.random) sees the same whatever drives the finger, and a session
+  // replays bit for bit. In a paced run the script thread computes it (no Lua on the loop).
+  std::vector<bool> script_alongside;
   // Real-time pacing (tools/app/pacer.hpp), with a real device attached: null runs as fast as
   // possible. With a pacer the loop prints nothing (no progress callback) and checks the
   // interrupt at every tick; a stall releases every device and stops the run. `realtime`: the

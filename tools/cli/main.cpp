@@ -235,6 +235,7 @@ int run_command(const std::vector<std::string>& args) {
   options.overrides = load.sets;
   options.interrupt = &g_interrupt;
   options.record_devices = plan.recorded();
+  options.script_alongside = plan.script_alongside;
   // Devices are built when the run starts (run_scenario), so that every one built is released
   // however the run ends; a device that cannot be built ends the run with its error (exit 2).
   options.make_device = [&](std::size_t f) { return graspsim::app::make_device(plan, registry, *scenario, f); };
