@@ -99,28 +99,33 @@ TEST_CASE("Pacer: a gap between two ticks past the stall timeout is a stall", "[
   CHECK_THROWS_WITH(app::Pacer(clock, 1000, 0.0), Catch::Contains("stall timeout"));
 }
 
-TEST_CASE("Pacer: a loop steadily slower than its rate falls behind but never stalls", "[pacer]") {
-  // Every tick's work takes w = s T with s > 1: tick n ends at start + (n + 1) s T, so its
-  // lateness is (n + 1)(s - 1) T, growing without bound, and every gap is s T. Swept over s:
-  // with s T under the timeout (20 ms) no tick stalls however late; at s T over it the first
-  // tick already does. 1000 ticks at 1 kHz.
+TEST_CASE("Pacer: a loop steadily slower than its rate lags past the lag limit", "[pacer]") {
+  // Every tick's work takes w = s T with s > 1 (T = 1 ms, 1 kHz): tick n ends at
+  // start + (n + 1) w, its gap is w and its lateness (n + 1)(w - T). Laws: it stalls at once if
+  // w > 20 ms (the stall timeout); otherwise it lags at the first tick whose lateness passes
+  // the 100 ms lag limit, n* = floor(100 ms / (w - T)) (integer ns, exact), and never before.
+  // Swept over s: 1.05 (n* = 2000, past the 1000 ticks run: no lag), 2 (n* = 100), 19 (n* = 5),
+  // 21 (a stall at tick 0).
   for (const double s : {1.05, 2.0, 19.0, 21.0}) {
+    INFO("s = " << s);
     FakeClock clock;
-    app::Pacer pacer(clock, 1000, 0.02);
+    app::Pacer pacer(clock, 1000, 0.02, 0.1);
     pacer.start();
     const auto work = static_cast<std::int64_t>(std::llround(s * 1e6));
-    std::int64_t stalls = 0;
+    std::int64_t first_stall = -1, first_lag = -1;
     for (std::int64_t n = 0; n < 1000; ++n) {
       clock.t += work;
       const app::TickPace p = pacer.end_tick(n);
-      stalls += p.stalled;
-      if (!p.overrun) FAIL("tick " << n << " on time at s = " << s);
+      if (p.stalled && first_stall < 0) first_stall = n;
+      if (p.lagging && first_lag < 0) first_lag = n;
+      if (!p.overrun) FAIL("tick " << n << " on time");
     }
-    const double last_lateness = 1000.0 * static_cast<double>(work - 1'000'000) * 1e-9;
-    CHECK(pacer.worst_lateness() == Approx(last_lateness).margin(1e-9));
     CHECK(pacer.worst_gap() == Approx(static_cast<double>(work) * 1e-9).margin(1e-12));
-    CHECK(stalls == (s * 1e-3 > 0.02 ? 1000 : 0));
+    CHECK(first_stall == (work > 20'000'000 ? 0 : -1));
+    const std::int64_t lag_tick = 100'000'000 / (work - 1'000'000);
+    CHECK(first_lag == (lag_tick < 1000 ? lag_tick : -1));
   }
+  CHECK_THROWS_WITH([] { FakeClock c; app::Pacer p(c, 1000, 0.02, 0.0); }(), Catch::Contains("lag limit"));
 }
 
 namespace {

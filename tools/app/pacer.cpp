@@ -26,10 +26,13 @@ void SteadyClock::sleep_until_ns(std::int64_t deadline) {
   }
 }
 
-Pacer::Pacer(MonotonicClock& clock, int rate, double stall_timeout)
-    : clock_(clock), rate_(rate), stall_ns_(static_cast<std::int64_t>(std::llround(stall_timeout * 1e9))) {
+Pacer::Pacer(MonotonicClock& clock, int rate, double stall_timeout, double lag_limit)
+    : clock_(clock), rate_(rate) {
   if (rate <= 0) throw std::invalid_argument("pacer: the servo rate must be > 0 Hz (got " + std::to_string(rate) + ")");
-  if (!(stall_timeout > 0.0)) throw std::invalid_argument("pacer: the stall timeout must be > 0 s");
+  if (!(stall_timeout > 0.0 && stall_timeout < 1e6)) throw std::invalid_argument("pacer: the stall timeout must be > 0 s");
+  if (!(lag_limit > 0.0 && lag_limit < 1e6)) throw std::invalid_argument("pacer: the lag limit must be > 0 s");
+  stall_ns_ = static_cast<std::int64_t>(std::llround(stall_timeout * 1e9));
+  lag_ns_ = static_cast<std::int64_t>(std::llround(lag_limit * 1e9));
 }
 
 void Pacer::start() {
@@ -51,6 +54,7 @@ TickPace Pacer::end_tick(std::int64_t n) {
   if (now > deadline) {
     pace.overrun = true;
     pace.lateness = static_cast<double>(now - deadline) * 1e-9;
+    pace.lagging = now - deadline > lag_ns_;
     ++overruns_;
     if (pace.lateness > worst_) worst_ = pace.lateness;
     last_end_ns_ = now;

@@ -16,6 +16,14 @@ namespace graspsim::app {
 // force for longer than that before every device is released.
 inline constexpr double kStallTimeout = 0.02;
 
+// The lag limit of graspsim run (s): a loop that falls this far behind its schedule releases
+// every device too, even if no single gap was a stall. A loop steadily slower than its rate
+// refreshes forces in time but runs at a longer period than the contact was tuned for (the
+// sampled-wall bound 2 b / T uses the real T), and its simulated time lags the hand: 100 ms is
+// a hand's reaction time, and far more than the scheduling hiccups a loop at full rate makes up
+// (a few ms on a shared VM).
+inline constexpr double kLagLimit = 0.1;
+
 // The force ramp of graspsim run with a real device (s, RunOptions::force_ramp): rendered
 // forces rise linearly from 0 over the first half second, slower than a hand's reflex, so a
 // device that starts inside an object (or a wrong mapping) pushes gently before it pushes fully.
@@ -38,6 +46,7 @@ class SteadyClock final : public MonotonicClock {
 struct TickPace {
   bool overrun = false;        // the tick's work ended after its deadline
   bool stalled = false;        // its forces followed the previous tick's by more than the timeout
+  bool lagging = false;        // it ended more than the lag limit past its deadline
   double lateness = 0.0;       // s: how far past the deadline (0 when on time)
   double gap = 0.0;            // s: since the previous tick ended (tick 0: since start())
 };
@@ -47,13 +56,12 @@ class Pacer {
   // rate: servo ticks per second (> 0); stall_timeout (s, > 0): the longest a device may hold
   // one force, i.e. the gap between two ticks' ends that counts as a stall.
   //
-  // A stall is measured by the gap, not by the lateness against the schedule: the hazard is a
-  // device holding a stale force, and a loop that runs steadily a little slower than its rate
-  // (lateness growing by a few us a tick) refreshes every force in time. Lateness is what
-  // overruns count; a loop that is late for long is slow motion, not danger, and the summary
-  // shows it. (Until session 4 a lateness past the timeout was a stall: loopback UDP on a
-  // shared VM then stopped runs whose longest gap was a few ms.)
-  Pacer(MonotonicClock& clock, int rate, double stall_timeout);
+  // Two limits, either of which releases every device: a stall (the gap between two ticks'
+  // ends past `stall_timeout`: a device holding a stale force) and a lag (a tick ending more than
+  // `lag_limit` past its deadline: a loop steadily too slow for its rate). Until session 4 a
+  // lateness past the 20 ms stall timeout was the only rule: hiccups on a shared VM, each a few
+  // ms and each made up, then stopped runs whose longest gap was a few ms.
+  Pacer(MonotonicClock& clock, int rate, double stall_timeout, double lag_limit = kLagLimit);
   void start();                        // tick 0's period begins now
   // After tick n's work: returns how it kept its deadline start + (n + 1) / rate, and sleeps
   // until that deadline when early. Deadlines stay on the absolute schedule (a late tick is made
@@ -65,6 +73,7 @@ class Pacer {
   double worst_lateness() const { return worst_; }   // s
   double worst_gap() const { return worst_gap_; }    // s: the longest gap between two ticks' ends
   double stall_timeout() const { return static_cast<double>(stall_ns_) * 1e-9; }   // s
+  double lag_limit() const { return static_cast<double>(lag_ns_) * 1e-9; }         // s
   std::string summary() const;   // "N of M ticks overran (worst X ms late), longest gap Y ms"
 
  private:
@@ -72,6 +81,7 @@ class Pacer {
   std::int64_t rate_;        // Hz
   std::int64_t start_ns_ = 0;
   std::int64_t stall_ns_;    // ns
+  std::int64_t lag_ns_;      // ns
   std::int64_t last_end_ns_ = 0;   // ns: when the previous tick ended (its forces were out)
   std::int64_t overruns_ = 0, ticks_ = 0;
   double worst_ = 0.0;       // s

@@ -129,6 +129,7 @@ RecordedDeviceRows read_device_rows(const std::string& trace, const std::string&
       d = recordings::read_dataset(trace, table + column);
     } catch (const recordings::TraceError&) {   // no such column: the table's others were read
       out->assign(n, -1);
+      r.counted = false;
       continue;
     }
     if (d.values.size() != n) throw ReplayError(trace + ": " + table + ": columns of different lengths");
@@ -311,7 +312,12 @@ RunOptions ReplayPlan::run_options(const std::string& out) const {
   options.max_ticks = recorded_ticks;
   options.force_ramp = force_ramp;
   options.attributes.emplace_back("replay_of", replay_of());
-  for (const RecordedFinger& r : fingers) options.record_devices.push_back(r.device.has_value());
+  for (const RecordedFinger& r : fingers) {
+    options.record_devices.push_back(r.device.has_value());
+    // A trace from before the counter columns: the replay writes none either, so that it can
+    // equal the recording (compare refuses tables whose columns differ).
+    if (r.device && !r.device->counted) options.device_counters = false;
+  }
   options.make_device = [this](std::size_t f) -> std::unique_ptr<hw::Device> {
     const std::string& name = scenario->model().fingers[f].name;
     if (const auto& d = fingers[f].device) {

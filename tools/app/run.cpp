@@ -122,13 +122,15 @@ std::int64_t flush_interval_ticks(const Model& model) {
   return period <= limit ? limit / period * period : limit;
 }
 
+constexpr std::size_t kNoColumn = static_cast<std::size_t>(-1);
+
 // One finger's /devices/<finger> table (recordings/README.md "Schema"): every device sample as
 // the device gave it, in its own frame, with the force sent to it in that frame.
 struct DeviceColumns {
   std::size_t finger;   // Model::fingers index
   recordings::TraceTable* table;
   std::size_t tick, time, device_time, position, gimbal, buttons, force, overrun;   // row offsets
-  std::size_t sequence = 0, new_samples = 0;                                         // row offsets
+  std::size_t sequence = kNoColumn, new_samples = kNoColumn;   // row offsets (kNoColumn: not written)
   const hw::SampleCounter* counter = nullptr;   // the device's sample numbering, if it has one
 };
 
@@ -140,9 +142,9 @@ std::string mapping_text(const hw::WorkspaceMapping& m) {
 }
 
 DeviceColumns device_columns(recordings::TraceWriter& writer, std::size_t finger, const std::string& name,
-                             hw::Device& device, std::size_t block_rows) {
+                             hw::Device& device, std::size_t block_rows, bool counters) {
   using recordings::DType;
-  DeviceColumns c{finger, &writer.table("devices/" + name, block_rows), 0, 0, 0, 0, 0, 0, 0, 0};
+  DeviceColumns c{finger, &writer.table("devices/" + name, block_rows), 0, 0, 0, 0, 0, 0, 0, 0, kNoColumn, kNoColumn};
   recordings::TraceTable& t = *c.table;
   c.tick = t.add_column("tick", 1, DType::kInt64, "tick");
   c.time = t.add_column("time", 1, DType::kFloat64, "s");
@@ -153,8 +155,10 @@ DeviceColumns device_columns(recordings::TraceWriter& writer, std::size_t finger
   c.force = t.add_column("force", 3, DType::kFloat64, "N");
   c.overrun = t.add_column("overrun", 1, DType::kInt8, "1");
   // Gaps and holds at the device's own rate (hw::SampleCounter; -1 for a device without one).
-  c.sequence = t.add_column("sequence", 1, DType::kInt64, "1");
-  c.new_samples = t.add_column("new_samples", 1, DType::kInt64, "1");
+  if (counters) {
+    c.sequence = t.add_column("sequence", 1, DType::kInt64, "1");
+    c.new_samples = t.add_column("new_samples", 1, DType::kInt64, "1");
+  }
   auto* inner = dynamic_cast<hw::MappedDevice*>(&device);
   c.counter = dynamic_cast<const hw::SampleCounter*>(inner ? &inner->inner() : &device);
   t.set_attribute(".", "device", device.describe());
@@ -286,7 +290,8 @@ RunResult run_scenario(const scripting::Scenario& scenario, const RunOptions& op
       for (std::size_t f = 0; f < options.record_devices.size() && f < devices.size(); ++f)
         if (options.record_devices[f])
           device_tables.push_back(device_columns(*writer_holder, f, model.fingers[f].name, *devices[f],
-                                                 options.block_rows > 0 ? options.block_rows : flush_ticks));
+                                                 options.block_rows > 0 ? options.block_rows : flush_ticks,
+                                                 options.device_counters));
     }
     Input input = make_input(model);
     TickRecord record = make_tick_record(model);
@@ -373,13 +378,21 @@ RunResult run_scenario(const scripting::Scenario& scenario, const RunOptions& op
         // The forces are out: wait for this tick's deadline (or count it late). A stall releases
         // every device at once, before anything else runs, and ends the run.
         pace = options.pacer->end_tick(n);
-        if (pace.stalled) {
+        if (pace.stalled || pace.lagging) {
           release_all();
-          char why[200];
-          std::snprintf(why, sizeof why,
-                        "the servo loop stalled: tick %lld's forces went out %.3f ms after the previous "
-                        "tick's (stall timeout %.3f ms); every device was released",
-                        static_cast<long long>(n), pace.gap * 1e3, options.pacer->stall_timeout() * 1e3);
+          char why[240];
+          if (pace.stalled) {
+            std::snprintf(why, sizeof why,
+                          "the servo loop stalled: tick %lld's forces went out %.3f ms after the previous "
+                          "tick's (stall timeout %.3f ms); every device was released",
+                          static_cast<long long>(n), pace.gap * 1e3, options.pacer->stall_timeout() * 1e3);
+          } else {
+            std::snprintf(why, sizeof why,
+                          "the servo loop fell behind: tick %lld ended %.3f ms past its deadline (lag limit "
+                          "%.3f ms): it cannot keep %lld Hz here; every device was released",
+                          static_cast<long long>(n), pace.lateness * 1e3, options.pacer->lag_limit() * 1e3,
+                          static_cast<long long>(model.rates.servo));
+          }
           throw std::runtime_error(why);
         }
       }
@@ -406,8 +419,10 @@ RunResult run_scenario(const scripting::Scenario& scenario, const RunOptions& op
         }
         row[c.buttons] = static_cast<double>(raw->buttons);
         row[c.overrun] = (recorded ? recorded->recorded_overrun() : pace.overrun) ? 1.0 : 0.0;
-        row[c.sequence] = c.counter ? static_cast<double>(c.counter->sample_sequence()) : -1.0;
-        row[c.new_samples] = c.counter ? static_cast<double>(c.counter->new_samples()) : -1.0;
+        if (c.sequence != kNoColumn) {
+          row[c.sequence] = c.counter ? static_cast<double>(c.counter->sample_sequence()) : -1.0;
+          row[c.new_samples] = c.counter ? static_cast<double>(c.counter->new_samples()) : -1.0;
+        }
       }
       if (recorder) {
         recorder->record(record, rendered, input, sim.state());
