@@ -271,6 +271,12 @@ TEST_CASE("A ring that runs dry holds the last sample and counts every held tick
     so.end_tick = 600;
     app::ScriptThread script(scenario, so);
     auto t = script.wrap(std::make_unique<GatedTrajectory>(120, open));
+    // Opens the gate on every way out, before ~ScriptThread joins: a failed REQUIRE must fail
+    // the test, not leave the script thread held and the join hanging.
+    struct OpenOnExit {
+      std::atomic<bool>& gate;
+      ~OpenOnExit() { gate.store(true); }
+    } open_on_exit{open};
     script.start();
     for (std::int64_t k = 0; k < 120; ++k)
       if (t->sample(static_cast<double>(k) / 3000).position.x() != static_cast<double>(k)) FAIL("tick " << k);
@@ -297,6 +303,24 @@ TEST_CASE("A request off the servo ticks is held and counted apart", "[lua_realt
   CHECK(t->sample(0.001).position.x() == 3.0);          // 3 / 3000 computed as 1 / 1000
   CHECK(t->sample(1.0 / 6000 + 0.001).position.x() == 3.0);   // between ticks 3 and 4: held
   CHECK(t->sample(4.0 / 3000).position.x() == 4.0);
+  CHECK(script.off_grid() == 1);
+  CHECK(t->sample(5.5 / 3000).position.x() == 5.0);   // between ticks 5 and 6: tick 5's, ahead of `last`
+  CHECK(script.off_grid() == 2);
+  CHECK(script.holds() == 0);
+}
+
+TEST_CASE("The first request off the servo ticks gets the tick before it and not a zero sample", "[lua_realtime]") {
+  // A device at its own rate under a servo rate that is no multiple of it (sim-phantom at 1 kHz
+  // under 1500 Hz) asks first at an instant between ticks: it gets the script's sample of the tick
+  // before (here x = tick number: 1.5 ticks -> tick 1), never the zero sample nobody computed.
+  const auto scenario = scripting::Scenario::load(write_scenario("grid_first", kViewClock));
+  std::atomic<bool> open{true};
+  app::ScriptThreadOptions so;
+  so.end_tick = 600;
+  app::ScriptThread script(scenario, so);
+  auto t = script.wrap(std::make_unique<GatedTrajectory>(1 << 30, open));
+  script.start();
+  CHECK(t->sample(1.5 / 3000).position.x() == 1.0);
   CHECK(script.off_grid() == 1);
   CHECK(script.holds() == 0);
 }

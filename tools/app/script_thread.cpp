@@ -37,14 +37,19 @@ hw::TrajectorySample PrefetchedTrajectory::sample(double t) {
   TrajectoryFeed& f = *feed_;
   const double rate = owner_.options().rate_servo;
   const double x = t * rate;
-  const std::int64_t k = std::isfinite(x) ? static_cast<std::int64_t>(std::llround(x)) : -1;
+  std::int64_t k = std::isfinite(x) && x > -0.5 ? static_cast<std::int64_t>(std::llround(x)) : -1;
   // Servo tick k's instant, computed as the loop computes it (Simulation::time); 1 ns absorbs
   // another rounding of the same instant (a device clock's j / 1000 for k = 3 j at 3 kHz).
-  if (k < 0 || !(std::fabs(t - static_cast<double>(k) / rate) <= 1e-9) || k < f.last.tick) {
-    ++f.off_grid;   // no servo tick, or one already gone from the ring: hold
-    return f.last.sample;
+  if (k < 0 || !(std::fabs(t - static_cast<double>(k) / rate) <= 1e-9)) {
+    // No servo tick at t: the script's sample of the tick before it (a zero-order hold of the
+    // servo-rate script), counted. Before this, the first such request returned the zero
+    // sample nobody computed (a sim-phantom at 1 kHz under a 1500 Hz loop: the hand at the
+    // origin).
+    ++f.off_grid;
+    if (k < 0) return f.last.sample;
+    k = static_cast<std::int64_t>(std::floor(x));
   }
-  if (k == f.last.tick) return f.last.sample;
+  if (k <= f.last.tick) return f.last.sample;   // this tick again, or one gone from the ring
   for (;;) {
     TickSample* s = f.ring.front();
     if (s == nullptr) {
