@@ -83,7 +83,9 @@ struct Outcome {
   std::vector<Watch> watch;   // per finger
 };
 
-Outcome run_on_sim_phantom(const std::string& scenario_name, const std::string& spec) {
+// `test`: the calling test's own name for its traces, so that tests ctest runs in parallel never
+// write the same file (two of them once both wrote sim_phantom_two_finger_lift.h5 and failed).
+Outcome run_on_sim_phantom(const std::string& scenario_name, const std::string& spec, const std::string& test) {
   const auto scenario = scripting::Scenario::load(kSource + "/scenarios/" + scenario_name + ".lua");
   const app::DeviceRegistry registry = app::default_registry();
   std::vector<std::string> options;
@@ -92,7 +94,9 @@ Outcome run_on_sim_phantom(const std::string& scenario_name, const std::string& 
   Outcome out;
   out.watch.resize(scenario.model().fingers.size());
   app::RunOptions o;
-  o.out = kTmp + "/sim_phantom_" + scenario_name + ".h5";
+  std::string device = spec;
+  std::replace(device.begin(), device.end(), ':', '_');
+  o.out = kTmp + "/sim_phantom_" + test + "_" + scenario_name + "_" + device + ".h5";
   o.make_device = [&](std::size_t f) -> std::unique_ptr<hw::Device> {
     return std::make_unique<Watched>(app::make_device(plan, registry, scenario, f), &out.watch[f]);
   };
@@ -109,7 +113,7 @@ TEST_CASE("Library scenarios a Phantom can perform meet their expectations with 
           "[e2e][devices][sim_phantom]") {
   for (const char* name : {"gravity_drop", "heavy_hold", "pole_balance", "push_along_floor", "rod_swing",
                            "stack_lift", "stack_mass_ratio", "two_finger_lift"}) {
-    const Outcome o = run_on_sim_phantom(name, "sim-phantom");
+    const Outcome o = run_on_sim_phantom(name, "sim-phantom", "library");
     INFO(name << " with every finger on sim-phantom: " << o.result.error);
     for (const auto& e : o.result.expectations) {
       INFO((e.passed ? "PASS " : "FAIL ") << e.what << ": " << e.detail);
@@ -132,7 +136,7 @@ TEST_CASE("Library scenarios a Phantom can perform meet their expectations with 
 // limit cut the force the user feels" (the stated reason for the Premium 1.5 column).
 TEST_CASE("sim-phantom: the two-finger lift passes but the Premium 1.5's continuous limit cuts what the hand feels",
           "[e2e][devices][sim_phantom]") {
-  const Outcome o = run_on_sim_phantom("two_finger_lift", "sim-phantom");
+  const Outcome o = run_on_sim_phantom("two_finger_lift", "sim-phantom", "limit");
   CHECK(o.result.passed());
   for (const Watch& w : o.watch) {
     INFO("peak request " << w.peak_request << " N, first cut at " << w.cut_time << " s (thermal limit "
@@ -146,7 +150,7 @@ TEST_CASE("sim-phantom: the two-finger lift passes but the Premium 1.5's continu
     CHECK(w.cut > 1.0);
   }
   // On the High Force model (C = 6.2 N) the same grip is never cut after the ramp.
-  const Outcome hf = run_on_sim_phantom("two_finger_lift", "sim-phantom:premium-1.5-hf");
+  const Outcome hf = run_on_sim_phantom("two_finger_lift", "sim-phantom:premium-1.5-hf", "limit");
   for (const Watch& w : hf.watch) {
     INFO("High Force: largest cut " << w.cut << " N");
     CHECK(w.cut <= 0.0);
@@ -160,7 +164,7 @@ TEST_CASE("sim-phantom: the two-finger lift passes but the Premium 1.5's continu
 // x = -0.15 + 0.1905 m (within the fingers' hold, 1 mm).
 TEST_CASE("sim-phantom: lift_and_place fails because the carry leaves the Premium 1.5's workspace",
           "[e2e][devices][sim_phantom]") {
-  const Outcome o = run_on_sim_phantom("lift_and_place", "sim-phantom");
+  const Outcome o = run_on_sim_phantom("lift_and_place", "sim-phantom", "workspace");
   CHECK(o.result.error.empty());
   CHECK_FALSE(o.result.passed());
   bool carry_failed = false;
