@@ -64,6 +64,15 @@ def work_precision(rows, out):
             ok = [r for r in pts if r["status"] == "ok"]
             ax.plot([number(r["wall_per_sim_s"]) for r in ok], [number(r["error"]) for r in ok],
                     marker=marker, color=colour, label=integrator, linewidth=1, markersize=5)
+            # The spread of the repeats (min to max wall time): where it is as wide as the steps
+            # between rates, the order of the points along x is noise, not cost.
+            spread = [r for r in ok if r.get("wall_min") and r.get("wall_max")]
+            if spread:
+                xs = [number(r["wall_per_sim_s"]) for r in spread]
+                ax.errorbar(xs, [number(r["error"]) for r in spread],
+                            xerr=[[x - number(r["wall_min"]) for x, r in zip(xs, spread)],
+                                  [number(r["wall_max"]) - x for x, r in zip(xs, spread)]],
+                            fmt="none", ecolor=colour, elinewidth=0.8, alpha=0.5, capsize=2)
             for r in pts:
                 err = number(r["error"])
                 y = err if 0 < err < math.inf else top
@@ -74,7 +83,14 @@ def work_precision(rows, out):
                             color=colour)
         ax.set_xscale("log")
         ax.set_yscale("log")
-        ax.set_title(case, fontsize=10)
+        costs = [number(r["wall_per_sim_s"]) for r in mine if r["status"] == "ok" and number(r["error"]) != 0]
+        title = case
+        if costs and max(costs) < 2 * min(costs):
+            # A scene whose cost the physics rate barely moves (the lift: the 3 kHz servo and
+            # 500 Hz haptic loops dominate): say so, or the zig-zag reads as a trade-off.
+            title += ("\ncost within %.1fx over all physics rates (set by the other loops);"
+                      "\nbars: min to max of the repeats" % (max(costs) / min(costs)))
+        ax.set_title(title, fontsize=10 if title == case else 7.5)
         ax.set_xlabel("wall s per simulated s (median)", fontsize=8)
         ax.set_ylabel(mine[0]["error_measure"] if mine else "error", fontsize=8)
         ax.tick_params(labelsize=7)
