@@ -30,7 +30,7 @@ ForceSafetyConfig udp_safety_of_model(const std::string& key) {
 
 // ---- UdpLink --------------------------------------------------------------------------------
 
-UdpLink::UdpLink(double timeout_s) : timeout_s_(timeout_s) {
+UdpLink::UdpLink(double timeout_s, udp::Mode expected) : timeout_s_(timeout_s), expected_(expected) {
   if (!(timeout_s > 0.0) || !std::isfinite(timeout_s)) {
     throw std::invalid_argument("udp device: timeout_s must be a positive number of seconds");
   }
@@ -38,8 +38,18 @@ UdpLink::UdpLink(double timeout_s) : timeout_s_(timeout_s) {
 
 void UdpLink::accept(const std::uint8_t* data, std::size_t size) {
   udp::Sample s;
-  if (udp::decode(data, size, &s) != udp::DecodeStatus::kOk) {
+  const udp::DecodeStatus status = udp::decode(data, size, &s);
+  if (status != udp::DecodeStatus::kOk) {
     ++counters_.malformed;   // also a valid hello or force: not something a server sends us
+    last_refusal_ = status;
+    if (!udp::peek_version(data, size, &last_refused_version_)) last_refused_version_ = 0;
+    return;
+  }
+  if (s.mode != expected_) {
+    // The server is not what the spec says it is: never use its sample, and remember the
+    // first one so the owner stops with a clear error (UdpDevice::read throws).
+    if (!mismatch_) mismatch_sequence_ = s.sequence;
+    mismatch_ = true;
     return;
   }
   if (has_sample_) {
@@ -110,7 +120,9 @@ std::string newtons(double f) {
 }  // namespace
 
 UdpDevice::UdpDevice(const UdpDeviceConfig& config)
-    : config_(config), link_(config.timeout_s), safety_(checked_safety(config)) {
+    : config_(config),
+      link_(config.timeout_s, config.lockstep ? udp::Mode::kLockstep : udp::Mode::kStreaming),
+      safety_(checked_safety(config)) {
   const std::string where = "udp device " + endpoint(config);
   if (config.port == 0) throw std::runtime_error(where + ": the server port must be 1 to 65535");
   addrinfo hints{};
@@ -199,6 +211,8 @@ bool UdpDevice::wait_readable(double max_wait_s) {
 }
 
 DeviceSample UdpDevice::read(std::int64_t /*tick*/, double time) {
+  // A mismatched server stays refused: never wait for it, never use it.
+  if (link_.mode_mismatch()) throw std::runtime_error(mode_mismatch_error());
   if (config_.lockstep) {
     // One answer is owed per datagram sent. Wait for each: a missing one is an error, never a
     // silent hold, so a lockstep run is the same run every time or a clear failure.
@@ -212,6 +226,7 @@ DeviceSample UdpDevice::read(std::int64_t /*tick*/, double time) {
     }
   }
   drain();
+  if (link_.mode_mismatch()) throw std::runtime_error(mode_mismatch_error());
   const DeviceSample s = link_.read(time);
   // Accepted since the previous read (the handshake's samples count at the first read).
   new_samples_ = static_cast<std::int64_t>(link_.counters().received - received_at_read_);
@@ -239,7 +254,7 @@ void UdpDevice::output(const Vec3& force) {
 bool UdpDevice::wait_for_first_sample(double max_wait_s) {
   const double end = wall_now() + max_wait_s;
   double next_hello = wall_now() + 0.25;
-  while (!link_.has_sample()) {
+  while (!link_.has_sample() && !link_.mode_mismatch()) {
     const double now = wall_now();
     if (now >= end) return false;
     if (now >= next_hello) {
@@ -251,13 +266,65 @@ bool UdpDevice::wait_for_first_sample(double max_wait_s) {
   return true;
 }
 
+bool UdpDevice::wait_for_hello_answer(double max_wait_s) {
+  const double end = wall_now() + max_wait_s;
+  while (answers_ < sent_) {
+    const double now = wall_now();
+    if (now >= end) return false;
+    if (wait_readable(end - now)) drain();
+  }
+  return true;
+}
+
+std::string UdpDevice::mode_mismatch_error() const {
+  const std::string where = endpoint(config_);
+  const std::string which = " (its sample " + std::to_string(link_.mismatch_sequence()) + " declared " +
+                            udp::describe(link_.expected_mode() == udp::Mode::kLockstep ? udp::Mode::kStreaming
+                                                                                         : udp::Mode::kLockstep) +
+                            ")";
+  if (config_.lockstep) {
+    return "udp device " + where + ": the server at " + where +
+           " streams samples (a real device?): a lockstep run would not be paced; drop ',lockstep'" + which;
+  }
+  return "udp device " + where + ": the server at " + where +
+         " is a lockstep peer (simulated or replaying: one sample per datagram it receives): a paced run would not "
+         "feed it in step; add ',lockstep'" + which;
+}
+
+std::string UdpDevice::refusal_note() const {
+  const UdpCounters& c = link_.counters();
+  if (c.malformed == 0) return "";
+  std::string note = "; " + std::to_string(c.malformed) + " datagram(s) refused, the last: ";
+  if (link_.last_refusal() == udp::DecodeStatus::kBadVersion) {
+    return note + "protocol version " + std::to_string(link_.last_refused_version()) + ", but this graspsim speaks version " +
+           std::to_string(udp::kVersion) + " only (update the server: hw/README.md \"UDP protocol\")";
+  }
+  return note + udp::describe(link_.last_refusal());
+}
+
+void UdpDevice::start_up() {
+  const std::string where = "udp device " + endpoint(config_);
+  if (config_.lockstep) {
+    // One answer is owed to the hello: wait for it (no resend, which would be answered too).
+    if (!wait_for_hello_answer(config_.answer_wait_s)) {
+      throw std::runtime_error(where + " (lockstep): no answer to the hello within " +
+                               std::to_string(config_.answer_wait_s) +
+                               " s: is `device_server --lockstep` running at that address?");
+    }
+  } else if (!wait_for_first_sample(config_.handshake_s) && !mode_mismatch()) {
+    throw std::runtime_error(where + ": no sample within " + std::to_string(config_.handshake_s) +
+                             " s of the hello: is a device server (tools/device_server) running there?" +
+                             refusal_note());
+  }
+  if (mode_mismatch()) throw std::runtime_error(mode_mismatch_error());
+  if (!has_sample()) {
+    throw std::runtime_error(where + " (lockstep): the answer to the hello is not a sample" + refusal_note());
+  }
+}
+
 std::unique_ptr<Device> make_udp_device(const UdpDeviceConfig& config) {
   auto device = std::make_unique<UdpDevice>(config);
-  if (!config.lockstep && config.handshake_s > 0.0 && !device->wait_for_first_sample(config.handshake_s)) {
-    throw std::runtime_error("udp device " + endpoint(config) + ": no sample within " +
-                             std::to_string(config.handshake_s) +
-                             " s of the hello: is a device server (tools/device_server) running there?");
-  }
+  if (config.handshake_s > 0.0) device->start_up();
   return device;
 }
 

@@ -73,17 +73,34 @@ bool get_finite(const std::uint8_t* p, int n, double* out) {
 
 }  // namespace
 
+static_assert(kVersion == 2, "describe(kBadVersion) names the version: update it with kVersion");
+
 const char* describe(DecodeStatus status) {
   switch (status) {
     case DecodeStatus::kOk: return "ok";
     case DecodeStatus::kTooShort: return "shorter than the 8-byte header";
     case DecodeStatus::kBadMagic: return "wrong magic (not a graspsim device datagram)";
-    case DecodeStatus::kBadVersion: return "unsupported protocol version";
+    case DecodeStatus::kBadVersion: return "unsupported protocol version (this graspsim speaks version 2 only)";
     case DecodeStatus::kBadType: return "unknown or unexpected message type";
     case DecodeStatus::kBadSize: return "wrong size for its message type";
     case DecodeStatus::kNotFinite: return "a NaN or infinite number";
+    case DecodeStatus::kBadMode: return "no valid server mode (bytes 72-75 must be 1 streaming or 2 lockstep, 76-79 zero)";
   }
   return "?";
+}
+
+const char* describe(Mode mode) {
+  switch (mode) {
+    case Mode::kStreaming: return "streaming";
+    case Mode::kLockstep: return "lockstep";
+  }
+  return "?";
+}
+
+bool peek_version(const std::uint8_t* data, std::size_t size, std::uint16_t* version) {
+  if (data == nullptr || size < kHeaderSize || std::memcmp(data, kMagic.data(), kMagic.size()) != 0) return false;
+  *version = get_u16(data + 4);
+  return true;
 }
 
 DecodeStatus peek_type(const std::uint8_t* data, std::size_t size, MessageType* type) {
@@ -112,6 +129,8 @@ std::size_t encode(const Sample& m, std::uint8_t* out) {
   put_f64(out + 16, m.device_time);
   for (int i = 0; i < 3; ++i) put_f64(out + 24 + 8 * i, m.position[i]);
   for (int i = 0; i < 3; ++i) put_f64(out + 48 + 8 * i, m.gimbal[i]);
+  put_u32(out + 72, static_cast<std::uint32_t>(m.mode));
+  put_u32(out + 76, 0);   // reserved: zero
   return kSampleSize;
 }
 
@@ -140,6 +159,14 @@ DecodeStatus decode(const std::uint8_t* data, std::size_t size, Sample* out) {
       !get_finite(data + 48, 3, m.gimbal)) {
     return DecodeStatus::kNotFinite;
   }
+  // Strict: the mode must be one of the two, never a default, and the reserved word zero, so a
+  // server that forgets to declare (or a v3 meaning in those bytes) is refused, not guessed.
+  const std::uint32_t mode = get_u32(data + 72);
+  if ((mode != static_cast<std::uint32_t>(Mode::kStreaming) && mode != static_cast<std::uint32_t>(Mode::kLockstep)) ||
+      get_u32(data + 76) != 0) {
+    return DecodeStatus::kBadMode;
+  }
+  m.mode = static_cast<Mode>(mode);
   *out = m;
   return DecodeStatus::kOk;
 }

@@ -24,10 +24,12 @@ namespace {
 
 // A device_server child process: the first line it prints gives its port; the rest is read
 // when it exits. It exits by itself after --samples; --idle-exit guards against a hung test.
+// In --lockstep unless told to stream (then at its --rate, on its own clock, like a real device).
 class Server {
  public:
-  explicit Server(const std::string& options) {
-    const std::string command = std::string(GRASPSIM_DEVICE_SERVER) + " --port 0 --lockstep --idle-exit 60 " + options;
+  explicit Server(const std::string& options, bool lockstep = true) {
+    const std::string command = std::string(GRASPSIM_DEVICE_SERVER) + " --port 0 " +
+                                (lockstep ? "--lockstep " : "") + "--idle-exit 60 " + options;
     pipe_ = popen(command.c_str(), "r");
     REQUIRE(pipe_ != nullptr);
     char line[512];
@@ -315,4 +317,55 @@ TEST_CASE("Every library scenario with its first finger on the UDP bridge reprod
     ++driven;
   }
   CHECK(driven >= 15);
+}
+
+// Protocol v2's safety fix: `,lockstep` makes a run unpaced and unprotected (no real-time pacing,
+// no stall release), so it must never be taken on the user's word against a server that
+// streams, i.e. one that may drive a real Phantom with a hand on it. The streaming device_server
+// declares `streaming` in every sample; graspsim refuses at the handshake, before the run: exit
+// 2, the error names the server and says to drop ',lockstep', and the server never receives a
+// force (it prints every one: --print-every 1, and its summary counts them).
+TEST_CASE("graspsim run with lockstep against a streaming device_server exits with the error and sends no force",
+          "[e2e][udp][devices][mode]") {
+  const std::string cli = GRASPSIM_CLI;
+  const std::string lift = std::string(GRASPSIM_SOURCE_DIR) + "/scenarios/two_finger_lift.lua";
+  const std::string tmp = GRASPSIM_TEST_TMP;
+  Server server("--rate 1000 --print-every 1 --idle-exit 1", false);
+  CHECK_THAT(server.first_line(), Catch::Contains("streaming"));
+  const std::string where = "127.0.0.1:" + std::to_string(server.port());
+  const std::string out = tmp + "/udp_mode_mismatch.h5";
+  std::filesystem::remove(out);
+  const auto run = graspsim::test::shell(cli + " run " + lift + " --duration 2 --out " + out +
+                                         " --device thumb=udp:" + where + ",lockstep");
+  INFO(run.output);
+  CHECK(run.status == 2);
+  CHECK_THAT(run.output, Catch::Contains("the server at " + where +
+                                         " streams samples (a real device?): a lockstep run would not be paced; "
+                                         "drop ',lockstep'"));
+  int status = -1;
+  const std::string served = server.finish(&status);   // after 1 s without a datagram from graspsim
+  INFO(served);
+  CHECK(status == 0);
+  CHECK(printed_forces(served).empty());
+  CHECK_THAT(served, Catch::Contains(" 0 forces, 1 hellos"));
+  // Without ',lockstep' the same kind of server is accepted (the run is paced and protected):
+  // checked in tests/hw/test_udp_device.cpp against an in-process peer, where no timing matters.
+}
+
+// The other way: a streaming spec against a lockstep device_server (a simulated or replaying peer
+// that only answers datagrams) is an error too (hw/README.md says why), naming the fix.
+TEST_CASE("graspsim run without lockstep against a lockstep device_server exits with the error", "[e2e][udp][devices][mode]") {
+  const std::string cli = GRASPSIM_CLI;
+  const std::string lift = std::string(GRASPSIM_SOURCE_DIR) + "/scenarios/two_finger_lift.lua";
+  Server server("--print-every 1 --idle-exit 1");
+  const std::string where = "127.0.0.1:" + std::to_string(server.port());
+  const auto run = graspsim::test::shell(cli + " run " + lift + " --duration 2 --out " + std::string(GRASPSIM_TEST_TMP) +
+                                         "/udp_mode_mismatch2.h5 --device thumb=udp:" + where);
+  INFO(run.output);
+  CHECK(run.status == 2);
+  CHECK_THAT(run.output, Catch::Contains("the server at " + where + " is a lockstep peer") &&
+                             Catch::Contains("add ',lockstep'"));
+  int status = -1;
+  const std::string served = server.finish(&status);
+  CHECK(printed_forces(served).empty());
 }

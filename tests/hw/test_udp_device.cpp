@@ -7,6 +7,8 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <poll.h>
+#include <string>
 
 #include "graspsim/hw/udp_device.hpp"
 #include "tests/hw/udp_peer.hpp"
@@ -92,8 +94,8 @@ TEST_CASE("UdpLink: malformed datagrams are counted and never used", "[hw][udp]"
   link.accept(b, sizeof b);                   // a NaN
   udp::encode(line_sample(9), b);
   link.accept(b, sizeof b - 1);               // truncated
-  b[4] = 2;
-  link.accept(b, sizeof b);                   // version 2
+  b[4] = 1;
+  link.accept(b, sizeof b);                   // version 1 (an old server)
   link.accept(nullptr, 0);                    // empty
   udp::encode(udp::Force{}, b);
   link.accept(b, udp::kForceSize);            // a force: not a sample
@@ -104,6 +106,58 @@ TEST_CASE("UdpLink: malformed datagrams are counted and never used", "[hw][udp]"
   CHECK(link.counters().held == 1);
   CHECK(link.newest().sequence == 7);
   CHECK(s.position == Vec3(7e-3, -14e-3, 0.5));
+}
+
+TEST_CASE("UdpLink: a sample declaring the other mode is never used and marks the link mismatched",
+          "[hw][udp][mode]") {
+  // Protocol v2: every sample declares the server's mode. The rule, both ways: a valid sample
+  // whose mode is not the expected one is not used (not received, not newest, the read holds
+  // the last good sample) and the link is mismatched from then on, naming the first offender.
+  for (const udp::Mode expected : {udp::Mode::kStreaming, udp::Mode::kLockstep}) {
+    const udp::Mode other = expected == udp::Mode::kLockstep ? udp::Mode::kStreaming : udp::Mode::kLockstep;
+    INFO("expected " << udp::describe(expected));
+    UdpLink link(1.0, expected);
+    CHECK(link.expected_mode() == expected);
+    udp::Sample good = line_sample(1);
+    good.mode = expected;
+    feed(link, good);
+    link.read(0.0);
+    CHECK(!link.mode_mismatch());
+    udp::Sample bad = line_sample(2);
+    bad.mode = other;
+    feed(link, bad);
+    udp::Sample bad2 = line_sample(3);
+    bad2.mode = other;
+    feed(link, bad2);
+    CHECK(link.mode_mismatch());
+    CHECK(link.mismatch_sequence() == 2);   // the first, not the last
+    const DeviceSample s = link.read(0.001);
+    CHECK(s.position == Vec3(1e-3, -2e-3, 0.5));   // sample 1 held, 2 and 3 never used
+    CHECK(link.newest().sequence == 1);
+    CHECK(link.counters().received == 1);
+    CHECK(link.counters().held == 1);
+    CHECK(link.counters().malformed == 0);   // valid datagrams: a mismatch, not garbage
+    feed(link, good);                        // a later right sample does not clear it
+    CHECK(link.mode_mismatch());
+  }
+  // The default is streaming: the safe assumption (a client that did not ask for lockstep).
+  UdpLink plain(1.0);
+  CHECK(plain.expected_mode() == udp::Mode::kStreaming);
+}
+
+TEST_CASE("UdpLink remembers why the last datagram was refused and its version", "[hw][udp][mode]") {
+  UdpLink link(1.0);
+  CHECK(link.last_refusal() == udp::DecodeStatus::kOk);
+  std::uint8_t b[udp::kSampleSize];
+  udp::encode(line_sample(0), b);
+  b[4] = 1;   // what a version-1 server sends (its size differs too; the version is checked first)
+  link.accept(b, 72);
+  CHECK(link.last_refusal() == udp::DecodeStatus::kBadVersion);
+  CHECK(link.last_refused_version() == 1);
+  link.accept(reinterpret_cast<const std::uint8_t*>("hello, world"), 12);
+  CHECK(link.last_refusal() == udp::DecodeStatus::kBadMagic);
+  CHECK(link.last_refused_version() == 0);
+  CHECK(!link.has_sample());
 }
 
 TEST_CASE("UdpLink: the link is lost exactly when no new sample came for longer than the timeout",
@@ -267,7 +321,7 @@ TEST_CASE("UdpDevice on loopback: malformed datagrams are counted and dropped", 
 
 TEST_CASE("UdpDevice: read never waits outside lockstep, and the first sample is waited for at start-up",
           "[hw][udp][loopback]") {
-  UdpPeer peer;
+  UdpPeer peer(udp::Mode::kStreaming);   // not lockstep: the server must stream
   UdpDeviceConfig c{"127.0.0.1", peer.port(), 0, 0.05, DeviceLimits{5.0}};
   c.safety.peak_force = c.safety.continuous_force = 5.0;   // the clamp alone (no derating, no ramp)
   c.safety.rise_time = 0.0;
@@ -309,6 +363,133 @@ TEST_CASE("UdpDevice: a server that does not answer is a clear error", "[hw][udp
   CHECK_THROWS_WITH(UdpDevice(no_port), Catch::Contains("port must be 1 to 65535"));
   UdpDeviceConfig bad_timeout{"127.0.0.1", silent.port(), 0, 0.0, DeviceLimits{}};
   CHECK_THROWS_WITH(UdpDevice(bad_timeout), Catch::Contains("timeout_s must be a positive"));
+}
+
+// ---- Protocol v2: the server's declared mode must match the spec's ---------------------------
+
+namespace {
+
+// The device's config for a spec with or without `,lockstep`, against the peer.
+UdpDeviceConfig spec_config(const UdpPeer& peer, bool lockstep) {
+  UdpDeviceConfig c = lockstep_config(peer, 1.0, 5.0);
+  c.lockstep = lockstep;
+  c.handshake_s = 5.0;   // guards, not thresholds: the peer's answer is queued before the wait
+  c.answer_wait_s = 5.0;
+  return c;
+}
+
+// Reads until the datagram the peer just sent has been taken in (a new sample, or a mismatch,
+// which throws). In lockstep read() waits by itself; a streaming read never waits, so retry it
+// with a 1 ms pause, at most 10000 times: a guard against a hung test, not a timing threshold.
+DeviceSample read_arrived(UdpDevice& d, std::int64_t tick, double time) {
+  for (int i = 0;; ++i) {
+    const DeviceSample s = d.read(tick, time);
+    if (d.new_samples() > 0 || d.config().lockstep || i == 10000) return s;
+    ::poll(nullptr, 0, 1);
+  }
+}
+
+}  // namespace
+
+TEST_CASE("UdpDevice: a lockstep spec against a streaming server is refused at start-up", "[hw][udp][mode]") {
+  // The safety case: `,lockstep` (an unpaced, unprotected run) against a server that declares it
+  // streams, e.g. one driving a real Phantom. start_up() (make_udp_device's handshake) throws
+  // telling the user to drop ',lockstep', before any force is sent.
+  UdpPeer streaming(udp::Mode::kStreaming);
+  UdpDevice d(spec_config(streaming, true));
+  CHECK(streaming.receive_hello().sequence == 0);
+  streaming.send(line_sample(0));
+  const std::string where = "127.0.0.1:" + std::to_string(streaming.port());
+  CHECK_THROWS_WITH(d.start_up(), Catch::Contains("udp device " + where + ": the server at " + where +
+                                                  " streams samples (a real device?): a lockstep run would not be "
+                                                  "paced; drop ',lockstep'") &&
+                                      Catch::Contains("sample 0 declared streaming"));
+  CHECK(!d.has_sample());
+  CHECK(d.datagrams_sent() == 1);   // the hello alone: no force ever went out
+  // The same server against the right spec starts.
+  UdpPeer streaming2(udp::Mode::kStreaming);
+  UdpDevice ok(spec_config(streaming2, false));
+  streaming2.receive_hello();
+  streaming2.send(line_sample(0));
+  CHECK_NOTHROW(ok.start_up());
+  CHECK(ok.has_sample());
+}
+
+TEST_CASE("UdpDevice: a streaming spec against a lockstep server is refused at start-up", "[hw][udp][mode]") {
+  // Chosen: an error, not a warning (hw/README.md): a lockstep peer sends one sample per
+  // datagram, so a paced client would get them late and by scheduling luck, a silently
+  // timing-dependent run; the fix is one word.
+  UdpPeer lockstep(udp::Mode::kLockstep);
+  UdpDevice d(spec_config(lockstep, false));
+  lockstep.receive_hello();
+  lockstep.send(line_sample(0));
+  CHECK_THROWS_WITH(d.start_up(), Catch::Contains("is a lockstep peer") && Catch::Contains("add ',lockstep'") &&
+                                      Catch::Contains("sample 0 declared lockstep"));
+  UdpPeer lockstep2(udp::Mode::kLockstep);
+  UdpDevice ok(spec_config(lockstep2, true));
+  lockstep2.receive_hello();
+  lockstep2.send(line_sample(0));
+  CHECK_NOTHROW(ok.start_up());
+  CHECK(ok.has_sample());
+}
+
+TEST_CASE("UdpDevice: a server that changes its declared mode mid-run stops the run", "[hw][udp][mode]") {
+  // Every sample must declare the spec's mode, not just the first: the first that does not makes
+  // read() throw (the run's error, after which the run releases every device), its position
+  // never used. Both ways, after a sweep of good ticks.
+  for (const bool lockstep : {true, false}) {
+    for (const std::uint32_t good_ticks : {1u, 10u, 100u}) {
+      INFO((lockstep ? "lockstep" : "streaming") << " spec, " << good_ticks << " good ticks");
+      const udp::Mode mode = lockstep ? udp::Mode::kLockstep : udp::Mode::kStreaming;
+      UdpPeer peer(mode);
+      UdpDevice d(spec_config(peer, lockstep));
+      peer.receive_hello();
+      peer.send(line_sample(0));
+      d.start_up();
+      for (std::uint32_t n = 0; n < good_ticks; ++n) {
+        read_arrived(d, n, n / 1000.0);
+        d.render(Vec3(0.0, 0.0, 1.0));
+        peer.receive_force();
+        peer.send(line_sample(n + 1));
+      }
+      // The answer to the last force: a sample of the other mode, sent as raw bytes.
+      read_arrived(d, good_ticks, good_ticks / 1000.0);
+      REQUIRE(d.newest().sequence == good_ticks);
+      d.render(Vec3(0.0, 0.0, 1.0));
+      peer.receive_force();
+      udp::Sample liar = line_sample(good_ticks + 1);
+      liar.mode = lockstep ? udp::Mode::kStreaming : udp::Mode::kLockstep;
+      std::uint8_t b[udp::kSampleSize];
+      peer.send(b, udp::encode(liar, b));
+      CHECK_THROWS_WITH(read_arrived(d, good_ticks + 1, (good_ticks + 1) / 1000.0),
+                        Catch::Contains(lockstep ? "drop ',lockstep'" : "add ',lockstep'") &&
+                            Catch::Contains("sample " + std::to_string(good_ticks + 1) + " declared"));
+      CHECK(d.newest().sequence == good_ticks);   // the liar's sample was never used
+      // The run then releases the device: a zero force goes out.
+      d.release();
+      const udp::Force last = peer.receive_force();
+      CHECK(last.force[0] == 0.0);
+      CHECK(last.force[1] == 0.0);
+      CHECK(last.force[2] == 0.0);
+      // And every later read throws too: the link stays mismatched.
+      CHECK_THROWS(d.read(good_ticks + 2, (good_ticks + 2) / 1000.0));
+    }
+  }
+}
+
+TEST_CASE("UdpDevice: a version 1 server is refused at start-up naming both versions", "[hw][udp][mode]") {
+  for (const bool lockstep : {true, false}) {
+    UdpPeer old;
+    UdpDeviceConfig c = spec_config(old, lockstep);
+    c.handshake_s = 0.3;   // streaming: waits the whole handshake (the v1 sample is refused)
+    UdpDevice d(c);
+    old.receive_hello();
+    std::uint8_t b[udp::kSampleSize];
+    udp::encode(line_sample(0), b);
+    b[4] = 1;
+    old.send(b, 72);   // a v1 sample: version 1, 72 bytes
+    CHECK_THROWS_WITH(d.start_up(), Catch::Contains("protocol version 1, but this graspsim speaks version 2"));
+  }
 }
 
 TEST_CASE("parse_udp_spec: HOST:PORT with options, and clear errors", "[hw][udp][spec]") {

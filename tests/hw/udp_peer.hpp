@@ -1,5 +1,7 @@
 // An in-process fake device server for the UdpDevice tests: a UDP socket on 127.0.0.1 that
-// learns the device's address from its hello and answers as the test tells it. No heap
+// learns the device's address from its hello and answers as the test tells it. Like a real
+// server it declares one mode (protocol v2), stamped on every sample send(Sample) sends:
+// lockstep unless told (most tests drive it in lockstep); send(bytes) sends anything. No heap
 // allocation in send/receive (the no-allocation test runs it between its counted calls).
 #pragma once
 
@@ -21,7 +23,7 @@ namespace udp = graspsim::hw::udp;
 
 class UdpPeer {
  public:
-  UdpPeer() {
+  explicit UdpPeer(udp::Mode mode = udp::Mode::kLockstep) : mode_(mode) {
     fd_ = ::socket(AF_INET, SOCK_DGRAM | SOCK_CLOEXEC, 0);
     sockaddr_in a{};
     a.sin_family = AF_INET;
@@ -69,12 +71,15 @@ class UdpPeer {
   void send(const void* data, std::size_t size) {
     ::sendto(fd_, data, size, 0, reinterpret_cast<const sockaddr*>(&device_), sizeof device_);
   }
-  void send(const udp::Sample& s) {
+  void send(udp::Sample s) {
+    s.mode = mode_;
     std::uint8_t b[udp::kSampleSize];
     send(b, udp::encode(s, b));
   }
+  udp::Mode mode() const { return mode_; }
 
  private:
+  udp::Mode mode_;   // declared in every sample send(Sample) sends
   int fd_ = -1;
   std::uint16_t port_ = 0;
   sockaddr_in device_{};

@@ -1,7 +1,8 @@
 // device_server: serves one device over the UDP device protocol (hw/README.md, "UDP protocol"):
 // a scripted motion (a line or a circle) or a replay of a trace's /servo hip and gimbal
 // columns, streamed at a rate or, with --lockstep, one sample per datagram received (no clock,
-// for tests). It prints the forces it receives. `device_server --help` lists the options.
+// for tests). Every sample declares which of the two this server is (protocol v2), so a client
+// never takes a real device's stream for a lockstep peer. It prints the forces it receives. `device_server --help` lists the options.
 #include <arpa/inet.h>
 #include <netinet/in.h>
 #include <poll.h>
@@ -34,7 +35,9 @@ prints the forces (N) it receives.
   --bind ADDR         local address (default 127.0.0.1; 0.0.0.0 for every interface)
   --rate HZ           samples per second (default 1000; a replay: the trace's rate_servo)
   --lockstep          no clock: answer every hello and force with exactly one datagram, the
-                      next sample (a lost one is replaced by a repeat of the last one sent)
+                      next sample (a lost one is replaced by a repeat of the last one sent).
+                      Every sample declares the mode: lockstep with this option, streaming
+                      without (the client's `,lockstep` must match, or it refuses to run)
   motion (default: --motion line):
   --motion line       from --from to --to (m, "x,y,z") in --duration s, then hold
   --motion circle     --center "x,y,z" (m), --radius m, --period s, in the x-y plane
@@ -258,6 +261,7 @@ int serve(const Options& o) {
     udp::Sample s;
     s.sequence = static_cast<std::uint32_t>(k);
     s.device_time = device_time;
+    s.mode = o.lockstep ? udp::Mode::kLockstep : udp::Mode::kStreaming;
     motion.at(k, device_time, &s);
     ++k;
     std::uint8_t b[udp::kSampleSize];

@@ -32,11 +32,13 @@ struct UdpDeviceConfig {
   DeviceLimits limits{};             // the clamp every rendered force goes through (the finger's)
   // Lockstep (tests, `device_server --lockstep`): the server answers every datagram we send with
   // exactly one datagram, and read() first waits for the answers to all we sent, so the run
-  // does not depend on timing. Off for a real device: read() never waits.
+  // does not depend on timing. Off for a real device: read() never waits. Either way every
+  // sample must declare the same mode (protocol v2): a mismatch is an error, never a guess.
   bool lockstep = false;
   double answer_wait_s = 10.0;   // s, wall clock, lockstep only: an unanswered datagram is an error
   double handshake_s = 2.0;      // s, wall clock: make_udp_device waits this long for the first
-                                 //   sample (not in lockstep; 0 = do not wait)
+                                 //   sample (in lockstep: answer_wait_s for the hello's answer;
+                                 //   0 = do not wait, in either mode)
   // The device's own limits, applied to every force sent after the clamp above (peak, thermal
   // continuous limit, ramp-in after start, link loss and release), on graspsim's time (the
   // `time` of the last read). limits() is the smaller of the two peaks.
@@ -58,9 +60,11 @@ struct UdpCounters {
 // of a read at graspsim time `time`. No heap allocation.
 class UdpLink {
  public:
-  explicit UdpLink(double timeout_s);
-  // One received datagram (any bytes): a valid newer sample replaces the newest; anything else
-  // is counted (late or malformed) and dropped.
+  // `expected`: the mode every sample must declare (lockstep for a `,lockstep` spec).
+  explicit UdpLink(double timeout_s, udp::Mode expected = udp::Mode::kStreaming);
+  // One received datagram (any bytes): a valid newer sample of the expected mode replaces the
+  // newest; a valid sample of the other mode is never used and marks the link mismatched (for
+  // good: the owner must stop); anything else is counted (late or malformed) and dropped.
   void accept(const std::uint8_t* data, std::size_t size);
   void count_malformed() { ++counters_.malformed; }   // a datagram too large to even read
   // The sample for a read at `time` (s): the newest sample; counts a hold when no new sample
@@ -72,9 +76,22 @@ class UdpLink {
   const udp::Sample& newest() const { return newest_; }   // valid once has_sample()
   const UdpCounters& counters() const { return counters_; }
   double timeout_s() const { return timeout_s_; }
+  udp::Mode expected_mode() const { return expected_; }
+  // True once a valid sample declared the other mode; mismatch_sequence() is the first one's.
+  bool mode_mismatch() const { return mismatch_; }
+  std::uint32_t mismatch_sequence() const { return mismatch_sequence_; }
+  // The last datagram refused by the decoder: why (kOk if none was), and its version field when
+  // it had graspsim's magic (0 otherwise), so a start-up error can say "version 1 server".
+  udp::DecodeStatus last_refusal() const { return last_refusal_; }
+  std::uint16_t last_refused_version() const { return last_refused_version_; }
 
  private:
   double timeout_s_;             // s, graspsim time
+  udp::Mode expected_;           // the mode every sample must declare
+  bool mismatch_ = false;        // a valid sample declared the other mode
+  std::uint32_t mismatch_sequence_ = 0;   // 1: the first such sample's sequence number
+  udp::DecodeStatus last_refusal_ = udp::DecodeStatus::kOk;
+  std::uint16_t last_refused_version_ = 0;   // 1: version field of the last refused datagram
   udp::Sample newest_{};         // the newest valid sample
   bool has_sample_ = false;
   bool fresh_ = false;           // a new sample came since the previous read
@@ -94,7 +111,8 @@ class UdpDevice final : public Device, public SampleClock, public SampleCounter 
   UdpDevice& operator=(const UdpDevice&) = delete;
 
   // Drains the socket (non-blocking; in lockstep after waiting for the answers owed) and returns
-  // the newest sample, in the server's frame and SI units. `tick` is not used.
+  // the newest sample, in the server's frame and SI units. `tick` is not used. Throws
+  // std::runtime_error (mode_mismatch_error()) once a sample declared the other mode.
   DeviceSample read(std::int64_t tick, double time) override;
   DeviceLimits limits() const override;    // N: min(config.limits, the safety's peak)
   std::string describe() const override;   // "udp 127.0.0.1:7001 (touch: 3.3 N peak, 0.88 N continuous)"
@@ -109,6 +127,20 @@ class UdpDevice final : public Device, public SampleClock, public SampleCounter 
   // Waits (wall clock, at most max_wait_s) for the first sample, resending the hello every
   // 0.25 s; true once one came. Start-up only: never called from read().
   bool wait_for_first_sample(double max_wait_s);
+  // Lockstep start-up: waits (wall clock, at most max_wait_s, no resend: one answer is owed per
+  // datagram) for the answer to the hello; true once it came (a sample or not).
+  bool wait_for_hello_answer(double max_wait_s);
+  // "udp device HOST:PORT: the server at HOST:PORT streams samples (a real device?): ..." for
+  // a mismatched link (the text tells the user what to change in the spec).
+  std::string mode_mismatch_error() const;
+  // Why no sample was accepted, for a start-up error: "" or "; N datagrams refused, the last:
+  // protocol version 1 (this graspsim speaks version 2; update the server ...)".
+  std::string refusal_note() const;
+  bool mode_mismatch() const { return link_.mode_mismatch(); }
+  // The start-up handshake make_udp_device runs: the first sample (wait_for_first_sample for
+  // handshake_s; in lockstep wait_for_hello_answer for answer_wait_s), then its declared mode.
+  // Throws std::runtime_error: no sample (with refusal_note()), or mode_mismatch_error().
+  void start_up();
 
   const UdpCounters& counters() const { return link_.counters(); }
   bool link_lost() const { return link_.link_lost(); }
@@ -146,8 +178,10 @@ class UdpDevice final : public Device, public SampleClock, public SampleCounter 
   Vec3 last_force_{0.0, 0.0, 0.0};     // N
 };
 
-// The backend's factory: a UdpDevice, and (unless lockstep or handshake_s = 0) its first sample
-// waited for; throws std::runtime_error "udp device HOST:PORT: no sample within S s ..." if none.
+// The backend's factory: a UdpDevice, and (unless handshake_s = 0) its first sample waited for
+// (in lockstep: the hello's one answer) and its declared mode checked; throws
+// std::runtime_error "udp device HOST:PORT: no sample within S s ..." if none came, or the
+// mode mismatch error, so either is the run's start-up error (exit 2, no force ever sent).
 std::unique_ptr<Device> make_udp_device(const UdpDeviceConfig& config);
 
 // Parses "HOST:PORT[,timeout=S][,local_port=N][,lockstep][,model=KEY][,max_force=N]
