@@ -16,6 +16,7 @@
 #include "graspsim/hw/device.hpp"
 #include "graspsim/hw/scripted_finger.hpp"
 #include "graspsim/hw/trajectory.hpp"
+#include "tests/support/random.hpp"
 
 using namespace graspsim::hw;
 
@@ -25,7 +26,6 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr double kMax = DBL_MAX;
 constexpr double kDenormMin = std::numeric_limits<double>::denorm_min();
-constexpr double kPi = 3.141592653589793;
 
 bool same_bits(const Vec3& a, const Vec3& b) {
   for (int i = 0; i < 3; ++i)
@@ -134,17 +134,8 @@ Outcome check_clamp(const Vec3& f, double limit) {
   return ok ? outcome : Outcome::kFailed;
 }
 
-// Uniform in [0, 1), built from the raw 64-bit output (mt19937_64's sequence is fixed by the
-// standard; the <random> distributions are not, across standard libraries).
-double uniform01(std::mt19937_64& rng) { return static_cast<double>(rng() >> 11) * 0x1.0p-53; }
-
-// A unit vector uniform on the sphere (Archimedes: z uniform in [-1, 1], azimuth uniform).
-Vec3 random_direction(std::mt19937_64& rng) {
-  const double z = 2.0 * uniform01(rng) - 1.0;
-  const double phi = 2.0 * kPi * uniform01(rng);
-  const double r = std::sqrt(std::max(0.0, 1.0 - z * z));
-  return Vec3(r * std::cos(phi), r * std::sin(phi), z);
-}
+using graspsim::test::random_direction;   // tests/support/random.hpp
+using graspsim::test::uniform01;
 
 // Every third request of the sweep is pushed onto an axis or a coordinate plane, with the
 // dropped components +0.0 or -0.0, so signed zeros and axis directions are covered too.

@@ -14,6 +14,7 @@
 
 #include "graspsim/hw/device_models.hpp"
 #include "graspsim/hw/force_safety.hpp"
+#include "tests/support/random.hpp"
 
 using namespace graspsim::hw;
 
@@ -22,16 +23,9 @@ namespace {
 constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr double kDenorm = std::numeric_limits<double>::denorm_min();
-constexpr double kPi = 3.141592653589793;
 
-double uniform01(std::mt19937_64& rng) { return static_cast<double>(rng() >> 11) * 0x1.0p-53; }
-
-Vec3 random_direction(std::mt19937_64& rng) {
-  const double z = 2.0 * uniform01(rng) - 1.0;
-  const double phi = 2.0 * kPi * uniform01(rng);
-  const double r = std::sqrt(std::max(0.0, 1.0 - z * z));
-  return Vec3(r * std::cos(phi), r * std::sin(phi), z);
-}
+using graspsim::test::random_direction;   // tests/support/random.hpp
+using graspsim::test::uniform01;
 
 // A request of the sweep: random directions with magnitudes log-uniform over 1e-320..1e308 N,
 // and one in four an extreme: NaN or infinite components, DBL_MAX, 1e308, denormals, zero.

@@ -16,6 +16,7 @@
 
 #include "graspsim/hw/scripted_finger.hpp"
 #include "graspsim/hw/trajectory.hpp"
+#include "tests/support/random.hpp"
 
 using namespace graspsim::hw;
 
@@ -194,14 +195,13 @@ TEST_CASE("a trajectory holds its first position before the first waypoint and i
 TEST_CASE("evaluation order does not change positions (the segment cache is invisible)",
           "[hw][trajectory]") {
   std::mt19937_64 rng(7);
-  const auto uniform01 = [&rng] { return static_cast<double>(rng() >> 11) * 0x1.0p-53; };
   std::vector<double> times = {0.0, 4.5};
   for (const Waypoint& w : kPath) {   // on, and one ulp either side of, every waypoint
     times.push_back(w.time);
     times.push_back(std::nextafter(w.time, -kInf));
     times.push_back(std::nextafter(w.time, kInf));
   }
-  for (int k = 0; k < 300; ++k) times.push_back(0.5 + 4.0 * uniform01());
+  for (int k = 0; k < 300; ++k) times.push_back(0.5 + 4.0 * graspsim::test::uniform01(rng));
   std::sort(times.begin(), times.end());
 
   for (Interpolation interp : {Interpolation::kLinear, Interpolation::kMinimumJerk}) {
