@@ -29,6 +29,18 @@ Broken broken(const std::string& name, const std::string& from, const std::strin
   return Broken{path, load_error(path)};
 }
 
+// The error loading valid.lua with these --set overrides ("no error" if it loads).
+std::string message(std::vector<std::string> sets) {
+  graspsim::scripting::LoadOptions options;
+  options.sets = std::move(sets);
+  try {
+    graspsim::scripting::Scenario::load(scripting_test::data_path("valid.lua"), options);
+  } catch (const graspsim::scripting::ScenarioError& e) {
+    return std::string(e.what());
+  }
+  return std::string("no error");
+}
+
 }  // namespace
 
 TEST_CASE("a missing file is reported with the OS reason", "[scenario][errors]") {
@@ -159,16 +171,6 @@ TEST_CASE("bad values are named with their field (the engine's validate() and th
 
 // Bad grasp and gyroscopic values name their field.
 TEST_CASE("bad gyroscopic, grasp and friction values are named with their field", "[scenario][errors]") {
-  const auto message = [](std::vector<std::string> sets) {
-    graspsim::scripting::LoadOptions options;
-    options.sets = std::move(sets);
-    try {
-      graspsim::scripting::Scenario::load(scripting_test::data_path("valid.lua"), options);
-    } catch (const graspsim::scripting::ScenarioError& e) {
-      return std::string(e.what());
-    }
-    return std::string("no error");
-  };
   CHECK_THAT(message({"gyroscopic=sometimes"}), Catch::Contains("gyroscopic"));
   CHECK_THAT(message({"grasp.torsion=twist"}), Catch::Contains("torsion"));
   CHECK_THAT(message({"grasp.torsion=gravity_drop"}), Catch::Contains("grasp.critical_area"));
@@ -182,16 +184,6 @@ TEST_CASE("bad gyroscopic, grasp and friction values are named with their field"
 
 // Bad sleep values name their field.
 TEST_CASE("bad sleep values are named with their field", "[scenario][errors]") {
-  const auto message = [](std::vector<std::string> sets) {
-    graspsim::scripting::LoadOptions options;
-    options.sets = std::move(sets);
-    try {
-      graspsim::scripting::Scenario::load(scripting_test::data_path("valid.lua"), options);
-    } catch (const graspsim::scripting::ScenarioError& e) {
-      return std::string(e.what());
-    }
-    return std::string("no error");
-  };
   CHECK_THAT(message({"sleep.time=0"}), Catch::Contains("sleep.time") && Catch::Contains("> 0 s"));
   CHECK_THAT(message({"sleep.linear_speed=-1"}), Catch::Contains("sleep.linear_speed"));
   CHECK_THAT(message({"sleep=3"}), Catch::Contains("sleep") && Catch::Contains("expected a table, true or false"));
