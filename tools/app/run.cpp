@@ -131,7 +131,11 @@ struct DeviceColumns {
   recordings::TraceTable* table;
   std::size_t tick, time, device_time, position, gimbal, buttons, force, overrun;   // row offsets
   std::size_t sequence = kNoColumn, new_samples = kNoColumn;   // row offsets (kNoColumn: not written)
+  // What the device offers, looked up once (not a dynamic_cast per tick on the loop):
+  const hw::MappedDevice* mapped = nullptr;     // its workspace mapping, if it is mapped
   const hw::SampleCounter* counter = nullptr;   // the device's sample numbering, if it has one
+  const hw::SampleClock* clock = nullptr;       // the device's own clock, if it has one
+  const RecordedPacing* recorded = nullptr;     // a replayed device's recorded overrun flags
 };
 
 std::string mapping_text(const hw::WorkspaceMapping& m) {
@@ -159,11 +163,13 @@ DeviceColumns device_columns(recordings::TraceWriter& writer, std::size_t finger
     c.sequence = t.add_column("sequence", 1, DType::kInt64, "1");
     c.new_samples = t.add_column("new_samples", 1, DType::kInt64, "1");
   }
-  auto* inner = dynamic_cast<hw::MappedDevice*>(&device);
-  c.counter = dynamic_cast<const hw::SampleCounter*>(inner ? &inner->inner() : &device);
+  c.mapped = dynamic_cast<const hw::MappedDevice*>(&device);
+  const hw::Device& own = c.mapped ? c.mapped->inner() : device;   // the device behind the mapping
+  c.counter = dynamic_cast<const hw::SampleCounter*>(&own);
+  c.clock = dynamic_cast<const hw::SampleClock*>(&own);
+  c.recorded = dynamic_cast<const RecordedPacing*>(&own);
   t.set_attribute(".", "device", device.describe());
-  const auto* mapped = dynamic_cast<const hw::MappedDevice*>(&device);
-  t.set_attribute(".", "mapping", mapped ? mapping_text(mapped->mapping()) : "identity (device frame = world)");
+  t.set_attribute(".", "mapping", c.mapped ? mapping_text(c.mapped->mapping()) : "identity (device frame = world)");
   t.set_attribute("gimbal", "order", "roll, pitch, yaw");
   char limit[32];
   std::snprintf(limit, sizeof limit, "%.17g", device.limits().max_force);
@@ -398,27 +404,19 @@ RunResult run_scenario(const scripting::Scenario& scenario, const RunOptions& op
       }
       for (const DeviceColumns& c : device_tables) {
         // The device's own view: before the mapping (device frame) and the force it was sent.
-        hw::Device* d = devices[c.finger].get();
-        const hw::DeviceSample* raw = &samples[c.finger];
-        const hw::Vec3* force = &rendered[c.finger];
-        if (auto* mapped = dynamic_cast<hw::MappedDevice*>(d)) {
-          raw = &mapped->last_device_sample();
-          force = &mapped->last_device_force();
-          d = &mapped->inner();
-        }
-        const auto* clock = dynamic_cast<const hw::SampleClock*>(d);
-        const auto* recorded = dynamic_cast<const RecordedPacing*>(d);
+        const hw::DeviceSample* raw = c.mapped ? &c.mapped->last_device_sample() : &samples[c.finger];
+        const hw::Vec3* force = c.mapped ? &c.mapped->last_device_force() : &rendered[c.finger];
         double* row = c.table->append_row();
         row[c.tick] = static_cast<double>(n);
         row[c.time] = static_cast<double>(n) / model.rates.servo;
-        row[c.device_time] = clock ? clock->sample_time() : t;
+        row[c.device_time] = c.clock ? c.clock->sample_time() : t;
         for (int i = 0; i < 3; ++i) {
           row[c.position + i] = raw->position[i];
           row[c.gimbal + i] = raw->gimbal[i];
           row[c.force + i] = (*force)[i];
         }
         row[c.buttons] = static_cast<double>(raw->buttons);
-        row[c.overrun] = (recorded ? recorded->recorded_overrun() : pace.overrun) ? 1.0 : 0.0;
+        row[c.overrun] = (c.recorded ? c.recorded->recorded_overrun() : pace.overrun) ? 1.0 : 0.0;
         if (c.sequence != kNoColumn) {
           row[c.sequence] = c.counter ? static_cast<double>(c.counter->sample_sequence()) : -1.0;
           row[c.new_samples] = c.counter ? static_cast<double>(c.counter->new_samples()) : -1.0;

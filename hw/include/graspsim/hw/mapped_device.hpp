@@ -44,6 +44,7 @@ class MappedDevice final : public Device {
   const DeviceSample& last_device_sample() const { return last_sample_; }   // device frame
   const Vec3& last_device_force() const { return last_force_; }             // N, device frame
   Device& inner() { return *device_; }
+  const Device& inner() const { return *device_; }
   const WorkspaceMapping& mapping() const { return mapping_; }
 
  protected:
