@@ -491,7 +491,7 @@ bool is_named_array(TableKind kind) {
 
 const std::vector<std::string>& fields_of(TableKind kind) {
   static const std::vector<std::string> kRoot = {
-      "name", "description", "duration", "seed", "rates", "gravity", "gyroscopic",
+      "name", "description", "duration", "seed", "rates", "gravity", "integrator", "gyroscopic",
       "grasp", "floor", "sleep", "objects", "fingers", "expect"};
   static const std::vector<std::string> kGrasp = {"torsion", "critical_area", "gimbal_finger", "dead_band",
                                                       "torsional_damping"};
@@ -616,6 +616,10 @@ ScenarioParts convert_scenario(const LuaValue& root, const std::string& default_
     s.seed = static_cast<std::uint64_t>(value);
   }
   s.model.gravity = r.vec3_or("gravity", s.model.gravity);
+  if (const LuaValue* i = r.get("integrator")) {
+    const std::string name = choice(*i, r.at("integrator"), {"paper", "implicit"}, "integrator");
+    s.model.integrator = name == "paper" ? Integrator::kPaper : Integrator::kImplicit;
+  }
   if (const LuaValue* g = r.get("gyroscopic")) {
     const std::string name = choice(*g, r.at("gyroscopic"), {"neglect", "explicit", "implicit"}, "gyroscopic");
     s.model.gyroscopic = name == "explicit" ? Gyroscopic::kExplicit

@@ -91,6 +91,16 @@ enum class Gyroscopic {
                // gain from the gyroscopic term while dt |w| <= J_min / (2 J_max))
 };
 
+// How a physics step moves the bodies (engine/README.md, "Integrators").
+enum class Integrator {
+  kPaper,      // the paper's explicit step (section 3.1): the residual force and torque at the
+               // start of the step, then v, p, w, R updated in turn; stable only while every
+               // coupled mode of a body on its springs is (stability.hpp)
+  kImplicit,   // linearly implicit: each body, and each group of bodies in contact, over all of
+               // its spring-damper couplings at once (fingers, floor, other bodies); passive for
+               // any stiffness, damping and physics rate
+};
+
 // Rotation about the axis through the god-objects of a two-finger grasp (paper, section 3.2).
 enum class Torsion {
   kNone,          // only the residual torque acts (the fingers' forces, gravity at the centre)
@@ -125,6 +135,7 @@ struct SleepParams {
 struct Model {
   Rates rates;
   SleepParams sleep;
+  Integrator integrator = Integrator::kPaper;
   Gyroscopic gyroscopic = Gyroscopic::kNeglect;
   GraspParams grasp;
   Vec3 gravity{0.0, 0.0, -9.81};   // m/s^2
