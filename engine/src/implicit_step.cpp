@@ -8,53 +8,55 @@
 namespace graspsim {
 namespace {
 
-// In-place Cholesky factorisation A = L L^T of the n x n symmetric positive definite matrix
-// stored row-major in `a` (only the lower triangle is read and written), then the solution of
-// A x = b in `b`. The island's matrix M + h C + h^2 K is positive definite (M > 0, and C, K
-// assemble as J^T G J with G positive semi-definite), so no pivoting is needed; a pivot that is
-// not positive (a non-finite input) leaves `b` non-finite, which the step's divergence check sees.
-void cholesky_solve(double* a, double* b, int n) {
+// Solves A x = b in place by Gaussian elimination with partial pivoting (`a` row-major n x n,
+// overwritten; `b` becomes x). The island's matrix M + h (h K + C) is positive definite but for
+// sliding points, whose friction force follows their normal force, mu t n^T, which makes it
+// unsymmetric; pivoting keeps the elimination backward stable either way. A zero or non-finite
+// pivot leaves `b` non-finite, which the step's divergence check sees.
+void lu_solve(double* a, double* b, int n) {
   for (int j = 0; j < n; ++j) {
-    double d = a[j * n + j];
-    for (int k = 0; k < j; ++k) d -= a[j * n + k] * a[j * n + k];
-    const double l = std::sqrt(d);
-    a[j * n + j] = l;
+    int p = j;
     for (int i = j + 1; i < n; ++i) {
-      double s = a[i * n + j];
-      for (int k = 0; k < j; ++k) s -= a[i * n + k] * a[j * n + k];
-      a[i * n + j] = s / l;
+      if (std::abs(a[i * n + j]) > std::abs(a[p * n + j])) p = i;
+    }
+    if (p != j) {
+      for (int k = j; k < n; ++k) std::swap(a[j * n + k], a[p * n + k]);
+      std::swap(b[j], b[p]);
+    }
+    const double pivot = a[j * n + j];
+    for (int i = j + 1; i < n; ++i) {
+      const double l = a[i * n + j] / pivot;
+      if (l == 0.0) continue;
+      for (int k = j + 1; k < n; ++k) a[i * n + k] -= l * a[j * n + k];
+      b[i] -= l * b[j];
     }
   }
-  for (int i = 0; i < n; ++i) {   // L y = b
+  for (int i = n - 1; i >= 0; --i) {
     double s = b[i];
-    for (int k = 0; k < i; ++k) s -= a[i * n + k] * b[k];
-    b[i] = s / a[i * n + i];
-  }
-  for (int i = n - 1; i >= 0; --i) {   // L^T x = y
-    double s = b[i];
-    for (int k = i + 1; k < n; ++k) s -= a[k * n + i] * b[k];
+    for (int k = i + 1; k < n; ++k) s -= a[i * n + k] * b[k];
     b[i] = s / a[i * n + i];
   }
 }
 
 // G = h K + C of a coupling in its mode (3x3, world): the force's change per unit of relative
-// velocity at the end of the step.
-Mat3 response(const Coupling& c, CouplingMode mode, double h) {
-  const Mat3 nn = c.normal * c.normal.transpose();
+// velocity at the end of the step. While sliding along unit t (tangential, the way the held
+// spring pulled) the tangential force is mu times the normal one: G = g_n (n + mu t) n^T.
+Mat3 response(const Coupling& c, CouplingMode mode, const Vec3& slide, double h) {
   const double g_n = h * c.k_n + c.c_n;
-  if (mode == CouplingMode::kSlip) return g_n * nn;
+  if (mode == CouplingMode::kSlip) return g_n * (c.normal + c.mu * slide) * c.normal.transpose();
+  const Mat3 nn = c.normal * c.normal.transpose();
   const double g_t = h * c.k_t + c.c_t;
   return g_n * nn + g_t * (Mat3::Identity() - nn);
 }
 
-// The constant part of the force, force + C u0, in its mode; while slipping the tangential part
-// is the sliding force instead.
-Vec3 constant_force(const Coupling& c, CouplingMode mode, const Vec3& u0, const Vec3& sliding) {
+// The constant part of the force, force + C u0, in its mode; while sliding along t the
+// tangential part is mu times the normal part, plus the viscous force.
+Vec3 constant_force(const Coupling& c, CouplingMode mode, const Vec3& u0, const Vec3& slide) {
   const Vec3& n = c.normal;
-  const Vec3 normal = (n.dot(c.force) + c.c_n * n.dot(u0)) * n;
-  if (mode == CouplingMode::kSlip) return normal + sliding;
+  const double normal = n.dot(c.force) + c.c_n * n.dot(u0);   // N
+  if (mode == CouplingMode::kSlip) return normal * (n + c.mu * slide) + c.viscous * slide;
   const Vec3 tangential = c.force - n.dot(c.force) * n + c.c_t * (u0 - n.dot(u0) * n);
-  return normal + tangential;
+  return normal * n + tangential;
 }
 
 // Adds s * J_x^T G J_y into the 6x6 block at (row, col) of the n-wide matrix, J = [I, -S(r)]:
@@ -94,7 +96,7 @@ Vec3 ImplicitStep::relative_velocity(const State& state, const Coupling& c, cons
     if (body < 0 || island_of_[body] < 0) return Vec3::Zero();
     return v[body] + w[body].cross(c.point - state.bodies[body].position);
   };
-  return point_velocity(c.b) - point_velocity(c.a);
+  return point_velocity(c.b) - (c.a < 0 ? c.world_velocity : point_velocity(c.a));
 }
 
 void ImplicitStep::solve(const Model& model, const State& state, const std::vector<Coupling>& couplings,
@@ -103,7 +105,7 @@ void ImplicitStep::solve(const Model& model, const State& state, const std::vect
                          const std::vector<Vec3>& torque, double h) {
   const int nb = static_cast<int>(model.bodies.size());
   mode_.assign(couplings.size(), CouplingMode::kHold);
-  sliding_.assign(couplings.size(), Vec3::Zero());
+  slide_.assign(couplings.size(), Vec3::Zero());
   solved_.assign(couplings.size(), Vec3::Zero());
   for (int b = 0; b < nb; ++b) {
     parent_[b] = b;
@@ -133,41 +135,42 @@ void ImplicitStep::solve(const Model& model, const State& state, const std::vect
       const int body = (c.b >= 0 && awake[c.b]) ? c.b : c.a;
       if (body >= 0 && awake[body] && find(body) == root) current_couplings_.push_back(static_cast<int>(i));
     }
+    // Rounds: solve, then change modes where the solution breaks a limit. A point leaving the
+    // cone is decided before any point letting go: a held point stops the body dead, and the
+    // torque that takes can lift other points that a sliding body keeps on the floor.
     for (int round = 0; round < kMaxRounds; ++round) {
       assemble_and_solve(model, state, couplings, v0, w0, force, torque, h);
-      bool changed = false;
+      bool slipped = false, released = false;
       for (int i : current_couplings_) {
         const Coupling& c = couplings[i];
         const Vec3 u0 = relative_velocity(state, c, v0, w0);
         const Vec3 u1 = relative_velocity(state, c, v1_, w1_);
-        const Vec3 f = constant_force(c, mode_[i], u0, sliding_[i]) - response(c, mode_[i], h) * u1;
-        solved_[i] = f;
-        if (c.mu < 0.0 || mode_[i] == CouplingMode::kOff) continue;
-        const double f_n = c.normal.dot(f);
-        if (f_n < 0.0) {   // it would pull: the point lets go
-          mode_[i] = CouplingMode::kOff;
-          solved_[i].setZero();
-          changed = true;
-          continue;
-        }
-        const Vec3 f_t = f - f_n * c.normal;
-        const double limit = c.mu * f_n + c.viscous;
+        solved_[i] = constant_force(c, mode_[i], u0, slide_[i]) - response(c, mode_[i], slide_[i], h) * u1;
+        if (c.mu < 0.0 || mode_[i] != CouplingMode::kHold) continue;
+        const double f_n = c.normal.dot(solved_[i]);
+        const Vec3 f_t = solved_[i] - f_n * c.normal;
         const double f_t_norm = f_t.norm();
-        if (mode_[i] == CouplingMode::kHold) {
-          if (f_t_norm > limit) {   // out of the cone: it slides, on the cone, the way it pulled
-            mode_[i] = CouplingMode::kSlip;
-            sliding_[i] = f_t * (limit / f_t_norm);
-            changed = true;
-          }
-        } else if (f_t_norm > 0.0) {
-          // Sliding: the force follows the normal force the solve found. A change of more than
-          // 1e-9 of it takes another round, so that mu f_n holds at the end of the step.
-          const Vec3 next = sliding_[i] * (limit / std::max(sliding_[i].norm(), 1e-300));
-          if ((next - sliding_[i]).norm() > 1e-9 * (limit + 1e-12)) changed = true;
-          sliding_[i] = next;
+        // Out of the cone (or pulling, which no cone holds): it slides the way it pulled. A
+        // pulling point slides before it may let go, so that a held point's drag, which pitches
+        // the body, is gone before the solve decides which points lift off.
+        if (f_t_norm > c.mu * std::max(0.0, f_n) + c.viscous) {
+          mode_[i] = CouplingMode::kSlip;
+          slide_[i] = f_t / f_t_norm;
+          slipped = true;
         }
       }
-      if (!changed) break;
+      if (!slipped) {
+        for (int i : current_couplings_) {
+          const Coupling& c = couplings[i];
+          if (c.mu < 0.0 || mode_[i] == CouplingMode::kOff || c.normal.dot(solved_[i]) >= 0.0) continue;
+          mode_[i] = CouplingMode::kOff;   // it would pull: the point lets go
+          released = true;
+        }
+      }
+      if (!slipped && !released) break;
+    }
+    for (int i : current_couplings_) {
+      if (mode_[i] == CouplingMode::kOff) solved_[i].setZero();
     }
   }
 }
@@ -199,8 +202,9 @@ void ImplicitStep::assemble_and_solve(const Model& model, const State& state,
   for (int i : current_couplings_) {
     const Coupling& c = couplings[i];
     if (mode_[i] == CouplingMode::kOff) continue;
-    const Mat3 g = response(c, mode_[i], h);
-    const Vec3 fc = constant_force(c, mode_[i], relative_velocity(state, c, v0, w0), sliding_[i]);
+    const Mat3 g = response(c, mode_[i], slide_[i], h);
+    Vec3 fc = constant_force(c, mode_[i], relative_velocity(state, c, v0, w0), slide_[i]);
+    if (c.a < 0) fc += g * c.world_velocity;   // the world side moves on: u1 = J q1 - v_world
     const bool in_b = c.b >= 0 && island_of_[c.b] >= 0;
     const bool in_a = c.a >= 0 && island_of_[c.a] >= 0;
     const Vec3 r_b = in_b ? Vec3(c.point - state.bodies[c.b].position) : Vec3::Zero();
@@ -228,7 +232,7 @@ void ImplicitStep::assemble_and_solve(const Model& model, const State& state,
       add_block(m, n, 6 * local_[c.a], 6 * local_[c.b], g, r_a, r_b, -h);
     }
   }
-  cholesky_solve(m, r, n);
+  lu_solve(m, r, n);
   for (int b : current_) {
     const int o = 6 * local_[b];
     v1_[b] = Vec3(r[o], r[o + 1], r[o + 2]);

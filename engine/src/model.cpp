@@ -83,7 +83,7 @@ ContactPair contact_pair(const Material& a, const Material& b) {
 
 ContactPair with_default_law(const ContactPair& pair, double mass, int physics_rate) {
   ContactPair out = pair;
-  const double omega = 2.0 * M_PI * physics_rate;   // rad/s
+  const double omega = 4.0 * M_PI * physics_rate;   // rad/s: a natural period of half a step
   if (std::isinf(out.stiffness)) out.stiffness = mass * omega * omega;
   if (std::isinf(out.damping)) out.damping = 2.0 * std::sqrt(out.stiffness * mass);
   return out;

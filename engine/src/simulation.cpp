@@ -121,7 +121,7 @@ void Simulation::physics_stage(const Input& input, TickRecord& record) {
     paper_contacts();
     for (std::size_t b = 0; b < model_.bodies.size(); ++b) paper_body_step(static_cast<int>(b), pitch_change, record);
   } else {
-    implicit_contacts();
+    implicit_contacts(input);
     implicit_solve();
     for (std::size_t b = 0; b < model_.bodies.size(); ++b) implicit_body_step(static_cast<int>(b), pitch_change, record);
   }

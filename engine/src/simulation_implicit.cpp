@@ -12,15 +12,21 @@
 namespace graspsim {
 
 // The couplings of this step: fingers pushing on a body, floor points, body-body points.
-void Simulation::implicit_contacts() {
+void Simulation::implicit_contacts(const Input& input) {
   const double h = 1.0 / model_.rates.physics;
   couplings_.clear();
   std::fill(contact_points_.begin(), contact_points_.end(), 0);
   // A finger in contact, pushing: its spring (pad and surface in series) and damper, whole while
   // it sticks, along the normal alone while its force is held on the cone. Its force over the
-  // window is in the body's window already; the coupling adds how it changes as the body moves.
+  // window is in the body's window already; the coupling adds how it changes as the body moves,
+  // and as the HIP goes on moving at its mean velocity over the last window (the hand's motion is
+  // not known ahead; taking it to stand still would hold the body back by k h v_hand).
   for (std::size_t f = 0; f < model_.fingers.size(); ++f) {
-    const FingerState& fs = state_.fingers[f];
+    FingerState& fs = state_.fingers[f];
+    const Vec3& hip = input.fingers[f].hip;
+    const Vec3 hip_velocity = fs.has_last_physics ? Vec3((hip - fs.hip_at_last_physics) / h) : Vec3::Zero();
+    fs.hip_at_last_physics = hip;
+    fs.has_last_physics = true;
     if (fs.phase == ContactPhase::kFree || fs.body < 0 || finger_force_[f].isZero(0.0)) continue;
     const BodyState& bs = state_.bodies[fs.body];
     const double k = finger_contact_pair(model_, static_cast<int>(f), fs.body).stiffness;   // N/m
@@ -30,6 +36,7 @@ void Simulation::implicit_contacts() {
     cp.slot = static_cast<int>(f);
     cp.b = fs.body;
     cp.point = finger_point_[f];
+    cp.world_velocity = hip_velocity;
     cp.normal = -(bs.rotation * fs.normal);   // into the body
     cp.force = Vec3::Zero();
     cp.k_n = k;

@@ -15,13 +15,15 @@ namespace graspsim {
 
 // One contact point as the implicit step sees it: the force it exerts at the start of the step
 // and how that force changes as the two bodies move during the step, a spring-damper about the
-// present state. With u the velocity of b's material at the point relative to a's, and over the
-// step the point's relative displacement taken as h u1 (backward Euler):
+// present state. With u the velocity of b's material at the point relative to a's (or to the
+// world side's velocity), and over the step the point's relative displacement taken as h u1
+// (backward Euler):
 //   f(u1) = force + C u0 - (h K + C) u1,   K = k_n n n^T + k_t (I - n n^T), C likewise.
 // Floor and body points are unilateral with Coulomb friction: after the solve a point whose
 // normal force would pull is dropped, and one whose tangential force leaves the cone slips, its
 // tangential spring and damper replaced by a sliding force mu f_n (+ viscous) (an active set,
-// ImplicitStep::solve). Fingers are already held in their cone by the servo stage (mu < 0).
+// ImplicitStep::solve); its sliding force follows its normal force within the solve.
+// Fingers are already held in their cone by the servo stage (mu < 0).
 struct Coupling {
   enum class Source : std::uint8_t { kFinger, kFloor, kBody };
   Source source = Source::kFinger;
@@ -30,6 +32,9 @@ struct Coupling {
   int b = -1;                      // body pushed by +f
   Vec3 point{0.0, 0.0, 0.0};       // m, world: where the force acts
   Vec3 normal{0.0, 0.0, 1.0};      // 1, world, unit: the direction in which the normal force pushes b
+  Vec3 world_velocity{0.0, 0.0, 0.0};   // m/s, world: the world side's velocity over the step when
+                                        //    a = -1 (a finger's HIP, taken to go on as over the last
+                                        //    window; 0 for the floor)
   Vec3 force{0.0, 0.0, 0.0};       // N, world, on b: at the start of the step (floor and body
                                    //    points: the penalty law unclamped, so that it extends linearly)
   double k_n = 0.0, c_n = 0.0;     // N/m, N s/m: along the normal
@@ -90,7 +95,8 @@ class ImplicitStep {
   std::vector<double> rhs_;                 // 6 n: right side, then the solution
   std::vector<Vec3> v1_, w1_;               // per body: the solved velocities
   std::vector<CouplingMode> mode_;          // per coupling
-  std::vector<Vec3> sliding_;               // N, world, per coupling: the sliding force while kSlip
+  std::vector<Vec3> slide_;                 // 1, world, per coupling: unit direction of the sliding
+                                            //    force while kSlip
   std::vector<Vec3> solved_;                // N, world, per coupling: force at the end of the step
   std::vector<int> current_;                // the island being solved: its bodies, couplings
   std::vector<int> current_couplings_;

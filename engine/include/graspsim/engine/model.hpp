@@ -60,11 +60,14 @@ ContactPair contact_pair(const Material& a, const Material& b);
 // damping unset (infinite on both sides), from the mass m it moves (a body's on the floor, the
 // reduced mass m_a m_b / (m_a + m_b) of two bodies) and the physics rate f (engine/README.md,
 // "Default contact"):
-//   k = m (2 pi f)^2 per point   the contact's natural period is one physics step, so a body
-//                                resting on one point sinks g / (2 pi f)^2 (0.099 mm at 50 Hz,
-//                                0.03 um at 3 kHz) and on four points a quarter of that
+//   k = m (4 pi f)^2 per point   the contact's natural period is half a physics step, so a body
+//                                resting on one point sinks g / (4 pi f)^2 (25 um at 50 Hz,
+//                                0.03 um at 3 kHz) and on four points a quarter of that; its
+//                                friction anchors give as little under a sideways load
 //   c = 2 sqrt(k m)              critical damping of that spring
-// A value set on either side is kept. Under the paper's integrator nothing is filled in.
+// Stiffer than any explicit step could take (h^2 k / m = 4 pi^2 > 4 at every rate): the implicit
+// step's damping of modes it cannot resolve keeps it quiet. A value set on either side is kept.
+// Under the paper's integrator nothing is filled in.
 ContactPair with_default_law(const ContactPair& pair, double mass, int physics_rate);
 
 struct BodyParams {

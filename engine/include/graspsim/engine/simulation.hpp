@@ -33,7 +33,7 @@ class Simulation {
   //                        about this tick's state; each island of touching bodies solved at once
   //                        for its velocities at the end of the step; then for every body, in
   //                        body order: record; the solved change as F and T; grasp rules, dead
-  //                        band; move (trapezoidal position, exact turn)
+  //                        band; move (backward Euler, exact turn)
   //              then per body: clear the window; flag a body whose state diverged (record.hpp)
   //   5 tick += 1
   // Time is tick / servo, computed, never accumulated.
@@ -55,7 +55,7 @@ class Simulation {
   void wake_touched_bodies();
   void paper_contacts();
   void paper_body_step(int b, double pitch_change, TickRecord& record);
-  void implicit_contacts();
+  void implicit_contacts(const Input& input);
   void implicit_solve();
   void implicit_body_step(int b, double pitch_change, TickRecord& record);
   void record_sleeping(int b, TickRecord& record);
