@@ -25,6 +25,8 @@ struct AccuracyFigures {
   double slide = NAN, slide_ref = NAN;                      // m: down the 30 degree slope in 1 s
   double step_ns = NAN, step_ns_min = NAN, step_ns_max = NAN;   // ns wall per physics step,
                                                                 //   settling (median, min, max)
+  double step_ns_cpu = NAN;     // ns of this thread's CPU per physics step, settling (median):
+                                //   steadier than wall time on a loaded machine
   double step_ns_alone = NAN;   // ns wall per physics step, settling, every loop at the physics
                                 //   rate (no idle servo and haptic ticks between physics steps)
 };
