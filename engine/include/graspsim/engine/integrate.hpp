@@ -41,4 +41,18 @@ void orthonormalize(Mat3& rotation);
 void integrate_body(const BodyParams& params, Gyroscopic gyroscopic, BodyState& body,
                     const Vec3& force, const Vec3& torque, double dt);
 
+// The implicit integrator's move of one body over dt (s) once its velocities at the end of the
+// step are known, given as the force F (N) and torque T (N m, world, about the centre of mass)
+// that change them:
+//   v1 = v0 + dt F / m          p = p + dt (v0 + v1) / 2
+//   w1 = w0 + dt R Jp^-1 R^T T  R = exp(S((w0 + w1) / 2) dt) R_old, then orthonormalize(R)
+// The position takes the mean of the two velocities (trapezoidal), so a constant force moves the
+// body exactly (1/2 a t^2, where p + dt v1 would overshoot by a t dt / 2); the velocities are the
+// implicit solve's. The gyroscopic change, if any, is in w0 already (ImplicitStep).
+void move_body(const BodyParams& params, BodyState& body, const Vec3& force, const Vec3& torque, double dt);
+
+// The gyroscopic change of the world angular velocity w over dt under `gyroscopic` (zero for
+// kNeglect), as integrate_body applies it before the torque's change.
+Vec3 gyroscopic_change(const BodyParams& params, Gyroscopic gyroscopic, const BodyState& body, double dt);
+
 }  // namespace graspsim
