@@ -76,8 +76,9 @@ TEST_CASE("graspsim_bench --quick writes the work-precision CSV and the stabilit
     if (r[3] == "ok") CHECK(finite_number(r[9]));   // an unstable run may have an infinite error
     CHECK(!r[10].empty());
     CHECK((r[18] == "paper" || r[18] == "implicit"));
-    // Both schemes must accept the contact scenes (the implicit one with the default stiffness).
-    if (contact.count(r[0])) CHECK(r[3] == "ok");
+    // The schemes of the contact scenes both run (the status is "ok" or "unstable: ...", never
+    // "refused: ..."): the implicit one accepts unset stiffness, the paper one has its soft floor.
+    if (contact.count(r[0])) CHECK(finite_number(r[9]));
   }
   std::ifstream log(dir + ".log");
   const std::string printed((std::istreambuf_iterator<char>(log)), std::istreambuf_iterator<char>());

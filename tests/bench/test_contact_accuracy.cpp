@@ -83,3 +83,37 @@ TEST_CASE("the settling scene runs 2 s of physics steps at every rate", "[bench]
       CHECK(r.steps == 2 * rate);
     }
 }
+
+// The implicit scheme's default contact (engine/README.md, "Default contact"): k = m (2 pi f)^2
+// per point, so the cube on its four bottom corners rests where 4 k d = m g, d = g / (4 (2 pi
+// f)^2): 0.0248 mm at 50 Hz, falling as 1 / f^2. The default damping is critical and backward
+// Euler damps more, so after 1 s the bounce is gone to round-off; the equilibrium is the step's
+// fixed point, held to 1e-9 relative (round-off of the solve). Level to round-off (< 1e-12 rad)
+// by symmetry, as on the soft floor.
+TEST_CASE("under the implicit scheme a cube placed touching rests g / (4 (2 pi f)^2) deep, level",
+          "[bench][law]") {
+  for (int rate : {50, 500, 3000}) {
+    const double w = 2.0 * kPi * rate;
+    const RestResult r = run_rest(rate, Integrator::kImplicit);
+    INFO(rate << " Hz: rests " << r.height_error << " m deep, tilt " << r.tilt << " rad");
+    REQUIRE_FALSE(r.diverged);
+    CHECK(r.height_error == Approx(9.81 / (4.0 * w * w)).epsilon(1e-9));
+    CHECK(r.tilt < 1e-12);
+  }
+}
+
+// Passivity (the implicit scheme's promise, engine/README.md, "Integrators"): springs, dampers
+// and Coulomb friction only store or take energy, and the cube starts at rest with no spring
+// stretched, so its kinetic and gravitational energy never rises above the start (E in
+// contact_accuracy.hpp). Every scene, every rate: at rest, sticking on 24 degrees, sliding on 30,
+// and dropped corner first. Tolerance 1e-12 J: E's terms are about 1 J, so round-off is ~1e-16 J
+// a step (2e-16 J measured at rest), and a passive step only lowers E from there.
+TEST_CASE("under the implicit scheme the cube's energy never rises above its start", "[bench][law]") {
+  for (int rate : {50, 500, 3000}) {
+    INFO(rate << " Hz");
+    CHECK(run_rest(rate, Integrator::kImplicit).energy_gain <= 1e-12);
+    CHECK(run_slope(rate, Integrator::kImplicit, 24.0 * kPi / 180.0).energy_gain <= 1e-12);
+    CHECK(run_slope(rate, Integrator::kImplicit, 30.0 * kPi / 180.0).energy_gain <= 1e-12);
+    CHECK(run_settle(rate, Integrator::kImplicit).energy_gain <= 1e-12);
+  }
+}

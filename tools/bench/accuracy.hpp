@@ -22,6 +22,7 @@ struct AccuracyFigures {
   double rest_depth = NAN;                                  // m: |z - 0.05| of the resting cube at 1 s
   double rest_tilt = NAN;                                   // rad: its tilt at 1 s
   double creep = NAN;                                       // m: along the 24 degree slope in 1 s
+  double creep_late = NAN;                                  // m: of which in the second half second
   double slide = NAN, slide_ref = NAN;                      // m: down the 30 degree slope in 1 s
   double step_ns = NAN, step_ns_min = NAN, step_ns_max = NAN;   // ns wall per physics step,
                                                                 //   settling (median, min, max)

@@ -43,9 +43,15 @@ struct ContactSetup {
 // the physics rate (setup.loops_at_physics_rate).
 Model contact_model(int physics_rate, Integrator s, double slope, const ContactSetup& setup = {});
 
+// Every scene reports energy_gain, J: the largest E - E0 over the run, E = 1/2 m v^2 + 1/2 w . J w
+// - m g . p (the contact springs' energy, never negative, left out). The cube starts at rest with
+// no spring stretched, so a passive step keeps it <= 0 (friction and damping only take energy):
+// a gain is energy the scheme made.
+
 // a) At rest face down on the level floor, after setup.duration.
 struct RestResult {
   bool diverged = false;
+  double energy_gain = 0.0;    // J
   double height_error = 0.0;   // m: |z - half| of the centre (how deep it rests)
   double tilt = 0.0;           // rad: body z from world z
   double speed = 0.0;          // m/s: |v| of the centre at the end
@@ -55,9 +61,12 @@ RestResult run_rest(int physics_rate, Integrator s, const ContactSetup& setup = 
 // b, c) On a slope, after setup.duration: how far the centre went along the floor.
 struct SlopeResult {
   bool diverged = false;
+  double energy_gain = 0.0;   // J
   double slide = 0.0;      // m: centre's displacement along x (downhill), floor plane
   double sideways = 0.0;   // m: |displacement along y| (0 by symmetry)
   double sink = 0.0;       // m: half - z, how deep it rests at the end
+  double late = 0.0;       // m: distance moved over the floor in the run's second half (a cube
+                           //    that holds has stopped: what it moved first is its springs' set)
 };
 SlopeResult run_slope(int physics_rate, Integrator s, double slope, const ContactSetup& setup = {});
 
@@ -70,6 +79,7 @@ double analytic_slide(double slope, double mu, double time, double g = 9.81);
 // onto an edge, then a face, and rests.
 struct SettleResult {
   bool diverged = false;
+  double energy_gain = 0.0;     // J
   long long steps = 0;          // physics steps run
   double height_error = 0.0;    // m: |z - half| at the end
   double tilt = 0.0;            // rad: the smallest angle of a body axis from world z at the end
