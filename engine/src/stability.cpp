@@ -561,11 +561,14 @@ std::string StabilityMonitor::update(const State& state) {
   report_ = check_.analyse(state);
   ++analyses_;
   if (!report_.unstable()) return "";
+  // A mode is its bodies and the springs that carry it (in any order): its motion's words and
+  // its radius move with the pose.
   const StabilityMode& m = report_.groups[report_.worst];
+  std::vector<std::string> springs = m.springs;
+  std::sort(springs.begin(), springs.end());
   std::string key;
   for (int b : m.bodies) key += std::to_string(b) + ",";
-  for (const std::string& s : m.springs) key += s + ";";
-  key += m.motion;
+  for (const std::string& s : springs) key += s + ";";
   if (std::find(warned_.begin(), warned_.end(), key) != warned_.end()) return "";
   warned_.push_back(key);
   return report_.warning(check_.model());

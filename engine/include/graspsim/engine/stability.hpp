@@ -143,7 +143,7 @@ class StabilityCheck {
 
 // The check over a run: after each physics tick, the state is analysed again when its contact
 // signature has changed (and at the first call), and a warning is given once per mode: a mode
-// met again (the same bodies, springs and motion, at another radius) gives none.
+// met again (the same bodies on the same springs, at another radius or pose) gives none.
 class StabilityMonitor {
  public:
   explicit StabilityMonitor(const Model& model);
@@ -160,7 +160,7 @@ class StabilityMonitor {
   ContactSignature last_;
   bool has_last_ = false;
   StabilityReport report_;
-  std::vector<std::string> warned_;   // the modes warned of (bodies, springs and motion)
+  std::vector<std::string> warned_;   // the modes warned of (bodies and springs)
   int analyses_ = 0;
 };
 
