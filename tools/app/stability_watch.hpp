@@ -28,9 +28,9 @@ class StabilityWatch {
   // The model's estimates (stability_warnings), before the run: warnings, never a refusal.
   void before_run();
 
-  // After the physics step of servo tick `tick` (at `time` s): analyses the state again if its
-  // contact set changed. Returns true when it added a warning; when refusing, throws
-  // StabilityRefusal after adding it.
+  // After the physics step of servo tick `tick` (at `time` s), under the paper's scheme: analyses
+  // the state again if its contact set changed. Returns true when it added a warning; when
+  // refusing, throws StabilityRefusal after adding it.
   bool after_physics(const State& state, std::int64_t tick, double time);
 
   // Every warning so far, one line each: the estimates as they are, the run's as
