@@ -209,6 +209,7 @@ RunResult run_scenario(const scripting::Scenario& scenario, const RunOptions& op
   writer.set_attribute("scenario_source", scenario.source());
   writer.set_attribute("scenario_source_hash", source_hash(scenario.source()));
   writer.set_attribute("overrides", join_lines(options.overrides));
+  writer.set_attribute("integrator", std::string(model.integrator == Integrator::kPaper ? "paper" : "implicit"));
   writer.set_attribute("parameters", join_lines(scenario.parameters()));
   writer.set_attribute("rate_servo", std::int64_t{model.rates.servo});
   writer.set_attribute("rate_haptic", std::int64_t{model.rates.haptic});
