@@ -77,13 +77,13 @@ std::vector<StabilityCoupling> StabilityCheck::couplings(const State& state) {
     c.damping = law(model_.fingers[f].damping, n, slipping);
     out.push_back(c);
   }
-  // Floor points that touched at the last step, at the pose now. A contact law left infinite
-  // (only possible when the integrator chooses it) has no spring to analyse here.
+  // Floor points that touched at the last step, at the pose now, with the law the step uses
+  // (floor_pair: the implicit scheme's defaults filled in).
   if (model_.floor.enabled) {
     for (std::size_t b = 0; b < state.bodies.size(); ++b) {
       const BodyState& bs = state.bodies[b];
       const BodyParams& bp = model_.bodies[b];
-      const ContactPair pair = contact_pair(bp.material, model_.floor.material);
+      const ContactPair pair = floor_pair(model_, static_cast<int>(b));
       if (!finite_law(pair)) continue;
       for (std::size_t k = 0; k < bs.floor_contacts.size(); ++k) {
         const VertexContact& vc = bs.floor_contacts[k];
@@ -107,8 +107,8 @@ std::vector<StabilityCoupling> StabilityCheck::couplings(const State& state) {
     for (int b = a + 1; b < nb; ++b) {
       const PairContact& pc = state.pairs[pair_index(a, b, nb)];
       if (pc.count == 0) continue;
-      const ContactPair pair = contact_pair(model_.bodies[a].material, model_.bodies[b].material);
-      if (!finite_law(pair)) continue;
+      const ContactPair pair = body_pair(model_, a, b);
+      if (!finite_law(pair)) continue;   // both rigid: such a pair does not collide
       const int n = contacts_.points(model_, state, a, b, points);
       for (int i = 0; i < n; ++i) {
         bool slipping = false;

@@ -25,13 +25,13 @@ Eigen::MatrixXd one_step_map(Integrator integrator, const Eigen::MatrixXd& k, co
     a.bottomLeftCorner(n, n) = -z;
     a.bottomRightCorner(n, n) = y;
   } else {
-    // S y1 = y0 - h^2 K' z0; z1 = z0 + (y0 + y1) / 2. S = I + h C' + h^2 K' is symmetric
-    // positive definite (I plus two positive semi-definite terms): Cholesky.
+    // S y1 = y0 - h^2 K' z0; z1 = z0 + y1. S = I + h C' + h^2 K' is symmetric positive definite
+    // (I plus two positive semi-definite terms): Cholesky.
     const Eigen::LLT<Eigen::MatrixXd> s(id + h * c + z);
     const Eigen::MatrixXd s_inv = s.solve(id);
     const Eigen::MatrixXd s_inv_z = s.solve(z);
-    a.topLeftCorner(n, n) = id - 0.5 * s_inv_z;
-    a.topRightCorner(n, n) = 0.5 * (id + s_inv);
+    a.topLeftCorner(n, n) = id - s_inv_z;
+    a.topRightCorner(n, n) = s_inv;
     a.bottomLeftCorner(n, n) = -s_inv_z;
     a.bottomRightCorner(n, n) = s_inv;
   }

@@ -155,7 +155,7 @@ Run run(const std::string& name, int physics, bool disturbed) {
 // unilateral limit caps the period-2 cycle it grows into. The reason is checked, not taken on
 // trust: disturbed by 0.1 mm at each finger and 0.01 rad/s on each body, the scene's period-2
 // content at its own rate is at least 20 times that at the rate the warning names, where the
-// check passes it (measured 27 to 10^7 times; a smooth motion's content falls only as the rate
+// check passes it (measured 51 to 1.8e6 times; a smooth motion's content falls only as the rate
 // squared, 4 times from 50 to 100 Hz).
 TEST_CASE("every library scenario the check passes runs bounded; those it flags grow period-2 cycles",
           "[stability][scenario]") {

@@ -35,8 +35,8 @@ inline constexpr double kUnstableRadius = 1.0 + 1e-6;
 // C' = L^T C L (same eigenvalues, better conditioned), and the state is (z, y = h z'), both in
 // the same units. One step of length h:
 //   kPaper (symplectic Euler, integrate.cpp):   y1 = (I - h C') y0 - h^2 K' z0,   z1 = z0 + y1
-//   kImplicit (linearly implicit velocity, trapezoidal position):
-//     S y1 = y0 - h^2 K' z0,  S = I + h C' + h^2 K',   z1 = z0 + (y0 + y1) / 2
+//   kImplicit (linearised backward Euler, implicit_step.hpp: the pose moves by h v1):
+//     S y1 = y0 - h^2 K' z0,  S = I + h C' + h^2 K',   z1 = z0 + y1
 // The map is the 2n x 2n matrix A with (z1, y1) = A (z0, y0).
 Eigen::MatrixXd one_step_map(Integrator integrator, const Eigen::MatrixXd& stiffness_over_mass,
                              const Eigen::MatrixXd& damping_over_mass, double h);
