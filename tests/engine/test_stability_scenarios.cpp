@@ -157,7 +157,7 @@ Run run(const std::string& name, int physics, bool disturbed) {
 // content at its own rate is at least 20 times that at the rate the warning names, where the
 // check passes it (measured 51 to 1.8e6 times; a smooth motion's content falls only as the rate
 // squared, 4 times from 50 to 100 Hz).
-TEST_CASE("every library scenario the check passes runs bounded; those it flags grow period-2 cycles",
+TEST_CASE("every library scenario the check passes runs bounded, and those it flags grow period-2 cycles",
           "[stability][scenario]") {
   const std::map<std::string, std::string> flagged = {
       {"dead_band", "the gravity_drop rod: sideways and yaw on two pads, 3.89 at 50 Hz"},
