@@ -79,8 +79,8 @@ void hinge(const BodyParams& bp, const TwoPointGrasp& grasp, double w_u, BodySta
   keep_axis_rate(bp, bs, grasp.axis, torque);
 }
 
-// Turns the body, orientation and centre, by `angle` about the grasp axis through the first
-// god-object (a rigid turn: the points on the axis stay put).
+}  // namespace
+
 void turn_about_axis(const TwoPointGrasp& grasp, double angle, BodyState& bs) {
   if (angle == 0.0) return;
   const Mat3 turn = Eigen::AngleAxisd(angle, grasp.axis).toRotationMatrix();
@@ -88,7 +88,41 @@ void turn_about_axis(const TwoPointGrasp& grasp, double angle, BodyState& bs) {
   bs.position = grasp.go_first + turn * (bs.position - grasp.go_first);
 }
 
-}  // namespace
+AxisRule plan_axis_rule(const Model& model, const State& state, int body, double dt, double pitch_change,
+                        const Vec3& contact_force, const Vec3& contact_torque) {
+  AxisRule rule;
+  if (model.grasp.torsion == Torsion::kNone) return rule;
+  TwoPointGrasp grasp = two_point_grasp(model, state, body);
+  if (!grasp.held) return rule;
+  const BodyState& bs = state.bodies[body];
+  const BodyParams& bp = model.bodies[body];
+  if (model.grasp.torsion == Torsion::kGimbal) {
+    const int g = model.grasp.gimbal_finger;
+    if (grasp.first != g && grasp.second != g) return rule;
+    if (grasp.second == g) grasp.axis = -grasp.axis;   // u from the gimbal finger to the other one
+    rule.grasp = grasp;
+    if (!(grasp.area > model.grasp.critical_area)) return rule;   // recorded, not constrained
+    rule.active = true;
+    rule.turn = pitch_change;
+    return rule;
+  }
+  rule.grasp = grasp;
+  rule.active = true;
+  if (!(grasp.area < model.grasp.critical_area)) return rule;   // the pads hold: no rotation
+  const Vec3& u = grasp.axis;
+  const Vec3 p = bs.position - grasp.go_first;   // from a contact point to the centre of mass
+  const double drop = p.cross(bp.mass * model.gravity * (1.0 - grasp.area / model.grasp.critical_area)).dot(u);
+  double turning = drop + (contact_torque + p.cross(contact_force)).dot(u);
+  if (std::abs(turning) <= model.grasp.dead_band) turning = 0.0;   // section 5, about u too
+  rule.torsion = turning;
+  if (model.grasp.torsional_damping > 0.0) {
+    rule.turn = dt * turning / model.grasp.torsional_damping;
+  } else {
+    rule.rate = bs.angular_velocity.dot(u) + dt * turning / axis_inertia(bp, bs, grasp.go_first, u);
+  }
+  return rule;
+}
+
 
 double gravity_drop(const Model& model, int body, const TwoPointGrasp& grasp, double dt,
                     const Vec3& floor_force, const Vec3& floor_torque, BodyState& bs, Vec3& torque,

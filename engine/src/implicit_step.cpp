@@ -79,8 +79,8 @@ ImplicitStep::ImplicitStep(const Model& model) {
   island_of_.resize(n);
   local_.resize(n);
   current_.reserve(n);
-  matrix_.resize(36 * n * n);
-  rhs_.resize(6 * n);
+  matrix_.resize(49 * n * n);
+  rhs_.resize(7 * n);
   v1_.resize(n);
   w1_.resize(n);
 }
@@ -102,7 +102,9 @@ Vec3 ImplicitStep::relative_velocity(const State& state, const Coupling& c, cons
 void ImplicitStep::solve(const Model& model, const State& state, const std::vector<Coupling>& couplings,
                          const std::vector<std::uint8_t>& awake, const std::vector<Vec3>& v0,
                          const std::vector<Vec3>& w0, const std::vector<Vec3>& force,
-                         const std::vector<Vec3>& torque, double h) {
+                         const std::vector<Vec3>& torque, const std::vector<std::uint8_t>& axis_active,
+                         const std::vector<Vec3>& axis, const std::vector<Vec3>& axis_point,
+                         const std::vector<double>& axis_rate, double h) {
   const int nb = static_cast<int>(model.bodies.size());
   mode_.assign(couplings.size(), CouplingMode::kHold);
   slide_.assign(couplings.size(), Vec3::Zero());
@@ -139,7 +141,7 @@ void ImplicitStep::solve(const Model& model, const State& state, const std::vect
     // cone is decided before any point letting go: a held point stops the body dead, and the
     // torque that takes can lift other points that a sliding body keeps on the floor.
     for (int round = 0; round < kMaxRounds; ++round) {
-      assemble_and_solve(model, state, couplings, v0, w0, force, torque, h);
+      assemble_and_solve(model, state, couplings, v0, w0, force, torque, axis_active, axis, axis_point, axis_rate, h);
       bool slipped = false, released = false;
       for (int i : current_couplings_) {
         const Coupling& c = couplings[i];
@@ -178,8 +180,12 @@ void ImplicitStep::solve(const Model& model, const State& state, const std::vect
 void ImplicitStep::assemble_and_solve(const Model& model, const State& state,
                                       const std::vector<Coupling>& couplings, const std::vector<Vec3>& v0,
                                       const std::vector<Vec3>& w0, const std::vector<Vec3>& force,
-                                      const std::vector<Vec3>& torque, double h) {
-  const int n = 6 * static_cast<int>(current_.size());
+                                      const std::vector<Vec3>& torque, const std::vector<std::uint8_t>& axis_active,
+                                      const std::vector<Vec3>& axis, const std::vector<Vec3>& axis_point,
+                                      const std::vector<double>& axis_rate, double h) {
+  int constraints = 0;
+  for (int b : current_) constraints += axis_active[b] ? 1 : 0;
+  const int n = 6 * static_cast<int>(current_.size()) + constraints;
   double* m = matrix_.data();
   double* r = rhs_.data();
   std::fill(m, m + n * n, 0.0);
@@ -231,6 +237,27 @@ void ImplicitStep::assemble_and_solve(const Model& model, const State& state,
       add_block(m, n, 6 * local_[c.b], 6 * local_[c.a], g, r_b, r_a, -h);
       add_block(m, n, 6 * local_[c.a], 6 * local_[c.b], g, r_a, r_b, -h);
     }
+  }
+  // Axis constraints: w1 . u = rate. The multiplier turns the body about the axis line through
+  // `axis_point`, as a hinge (momentum M d, d = (u x (c - p), u) the twist of a unit turn about
+  // that line), so that setting the rate does not move the axis itself: the fingers on it are
+  // not asked for the pivot's force (grasp_rules.hpp). Unsymmetric, so the elimination pivots.
+  int row = 6 * static_cast<int>(current_.size());
+  for (int b : current_) {
+    if (!axis_active[b]) continue;
+    const int o = 6 * local_[b];
+    const BodyParams& bp = model.bodies[b];
+    const Mat3& R = state.bodies[b].rotation;
+    const Vec3& u = axis[b];
+    const Vec3 dv = u.cross(state.bodies[b].position - axis_point[b]);              // m/s per rad/s
+    const Vec3 dl = R * bp.inertia.cwiseProduct(R.transpose() * u);                  // kg m^2
+    for (int i = 0; i < 3; ++i) {
+      m[row * n + o + 3 + i] = u[i];
+      m[(o + i) * n + row] = bp.mass * dv[i];
+      m[(o + 3 + i) * n + row] = dl[i];
+    }
+    r[row] = axis_rate[b];
+    ++row;
   }
   lu_solve(m, r, n);
   for (int b : current_) {

@@ -54,6 +54,11 @@ Simulation::Simulation(Model model)
   couplings_.reserve(floor_points + model_.fingers.size() + kMaxPairPoints * n * (n > 0 ? n - 1 : 0) / 2);
   awake_.resize(n);
   floor_points_.resize(n);
+  rules_.resize(n);
+  axis_active_.resize(n);
+  axis_.resize(n);
+  axis_point_.resize(n);
+  axis_rate_.resize(n);
   v0_.resize(n);
   w0_.resize(n);
   external_force_.resize(n);
@@ -110,6 +115,7 @@ void Simulation::servo_stage(const Input& input, TickRecord& record) {
       BodyState& bs = state_.bodies[b];
       bs.window_force -= force;
       bs.window_torque += (contact_point - bs.position).cross(-force);
+      if (model_.integrator == Integrator::kImplicit) state_.fingers[f].window_force -= force;
     }
   }
 }
@@ -122,8 +128,8 @@ void Simulation::physics_stage(const Input& input, TickRecord& record) {
     for (std::size_t b = 0; b < model_.bodies.size(); ++b) paper_body_step(static_cast<int>(b), pitch_change, record);
   } else {
     implicit_contacts(input);
-    implicit_solve();
-    for (std::size_t b = 0; b < model_.bodies.size(); ++b) implicit_body_step(static_cast<int>(b), pitch_change, record);
+    implicit_solve(pitch_change);
+    for (std::size_t b = 0; b < model_.bodies.size(); ++b) implicit_body_step(static_cast<int>(b), record);
   }
   collision_stale_ = true;
 }

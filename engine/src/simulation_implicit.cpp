@@ -16,18 +16,22 @@ void Simulation::implicit_contacts(const Input& input) {
   const double h = 1.0 / model_.rates.physics;
   couplings_.clear();
   std::fill(contact_points_.begin(), contact_points_.end(), 0);
-  // A finger in contact, pushing: its spring (pad and surface in series) and damper, whole while
-  // it sticks, along the normal alone while its force is held on the cone. Its force over the
-  // window is in the body's window already; the coupling adds how it changes as the body moves,
-  // and as the HIP goes on moving at its mean velocity over the last window (the hand's motion is
-  // not known ahead; taking it to stand still would hold the body back by k h v_hand).
+  // A finger in contact: its force over the window, its spring (pad and surface in series) and
+  // damper about it, and its friction cone, as a floor point's (the solve decides whether it
+  // holds, slides or lets go: a sliding finger's friction applied as it was would flip a light
+  // body's spin every step). The spring's far end is the HIP, taken to go on at its mean velocity
+  // over the last window (the hand's motion is not known ahead; taking it to stand still would
+  // hold the body back by k h v_hand).
+  const double per_tick = 1.0 / static_cast<double>(divisors_.physics);
   for (std::size_t f = 0; f < model_.fingers.size(); ++f) {
     FingerState& fs = state_.fingers[f];
     const Vec3& hip = input.fingers[f].hip;
     const Vec3 hip_velocity = fs.has_last_physics ? Vec3((hip - fs.hip_at_last_physics) / h) : Vec3::Zero();
     fs.hip_at_last_physics = hip;
     fs.has_last_physics = true;
-    if (fs.phase == ContactPhase::kFree || fs.body < 0 || finger_force_[f].isZero(0.0)) continue;
+    const Vec3 window = fs.window_force * per_tick;   // N, on the body: the window's mean
+    fs.window_force.setZero();
+    if (fs.phase == ContactPhase::kFree || fs.body < 0 || window.isZero(0.0)) continue;
     const BodyState& bs = state_.bodies[fs.body];
     const double k = finger_contact_pair(model_, static_cast<int>(f), fs.body).stiffness;   // N/m
     const double c = model_.fingers[f].damping;                                          // N s/m
@@ -36,14 +40,13 @@ void Simulation::implicit_contacts(const Input& input) {
     cp.slot = static_cast<int>(f);
     cp.b = fs.body;
     cp.point = finger_point_[f];
-    cp.world_velocity = hip_velocity;
     cp.normal = -(bs.rotation * fs.normal);   // into the body
-    cp.force = Vec3::Zero();
-    cp.k_n = k;
-    cp.c_n = c;
-    const bool sticking = fs.phase == ContactPhase::kStick;
-    cp.k_t = sticking ? k : 0.0;
-    cp.c_t = sticking ? c : 0.0;
+    cp.world_velocity = hip_velocity;
+    cp.force = window;
+    cp.k_n = cp.k_t = k;
+    cp.c_n = cp.c_t = c;
+    cp.mu = fs.friction_mu;
+    cp.viscous = fs.viscous_force;
     couplings_.push_back(cp);
   }
   if (model_.floor.enabled) {
@@ -66,10 +69,9 @@ void Simulation::implicit_contacts(const Input& input) {
   body_contacts_.couplings(model_, state_, couplings_, contact_points_);
 }
 
-// Solves every island for its velocities at the end of the step, then keeps what the solve
-// decided: which points slip, how many floor points push, and the contact wrench on each body
-// (for the grasp rules).
-void Simulation::implicit_solve() {
+// Plans each body's grasp rule, solves every island for its velocities at the end of the step,
+// then keeps what the solve decided: which points slip and how many floor points push.
+void Simulation::implicit_solve(double pitch_change) {
   const double h = 1.0 / model_.rates.physics;
   const double per_tick = 1.0 / static_cast<double>(divisors_.physics);
   const std::size_t nb = model_.bodies.size();
@@ -82,9 +84,37 @@ void Simulation::implicit_solve() {
     external_force_[b] = bs.window_force * per_tick + bp.mass * model_.gravity;
     external_torque_[b] = bs.window_torque * per_tick;
   }
-  implicit_.solve(model_, state_, couplings_, awake_, v0_, w0_, external_force_, external_torque_, h);
-
+  // The fingers' forces enter through their couplings: what is left of the bodies' windows is
+  // what fingers pushed that are no longer in contact, and the torque of each finger's force
+  // about where its contact point is now, not where it was when the GO last moved.
   std::fill(contact_wrench_.begin(), contact_wrench_.end(), Wrench{});
+  for (const Coupling& c : couplings_) {
+    if (c.source == Coupling::Source::kFinger) {
+      external_force_[c.b] -= c.force;
+      external_torque_[c.b] -= (c.point - state_.bodies[c.b].position).cross(c.force);
+      continue;
+    }
+    // The floor's and other bodies' push at the start of the step, pushing only, for the rules.
+    const Vec3 f = std::max(0.0, c.normal.dot(c.force)) * c.normal;
+    contact_wrench_[c.b].force += f;
+    contact_wrench_[c.b].torque += (c.point - state_.bodies[c.b].position).cross(f);
+    if (c.a >= 0) {
+      contact_wrench_[c.a].force -= f;
+      contact_wrench_[c.a].torque -= (c.point - state_.bodies[c.a].position).cross(f);
+    }
+  }
+  for (std::size_t b = 0; b < nb; ++b) {
+    rules_[b] = awake_[b] ? plan_axis_rule(model_, state_, static_cast<int>(b), h, pitch_change,
+                                           contact_wrench_[b].force, contact_wrench_[b].torque)
+                          : AxisRule{};
+    axis_active_[b] = rules_[b].active ? 1 : 0;
+    axis_[b] = rules_[b].grasp.axis;
+    axis_point_[b] = rules_[b].grasp.go_first;
+    axis_rate_[b] = rules_[b].rate;
+  }
+  implicit_.solve(model_, state_, couplings_, awake_, v0_, w0_, external_force_, external_torque_, axis_active_,
+                  axis_, axis_point_, axis_rate_, h);
+
   std::fill(floor_points_.begin(), floor_points_.end(), 0);
   const int n = static_cast<int>(nb);
   for (std::size_t i = 0; i < couplings_.size(); ++i) {
@@ -98,19 +128,13 @@ void Simulation::implicit_solve() {
     } else {
       state_.pairs[pair_index(c.a, c.b, n)].points[c.slot].slipping = slipping;
     }
-    const Vec3& f = implicit_.force(i);
-    contact_wrench_[c.b].force += f;
-    contact_wrench_[c.b].torque += (c.point - state_.bodies[c.b].position).cross(f);
-    if (c.a >= 0) {
-      contact_wrench_[c.a].force -= f;
-      contact_wrench_[c.a].torque -= (c.point - state_.bodies[c.a].position).cross(f);
-    }
   }
 }
 
-// One body after the solve: its velocity change as the force and torque that make it, the grasp
-// rules and the dead band on that torque, then the move.
-void Simulation::implicit_body_step(int b, double pitch_change, TickRecord& record) {
+// One body after the solve: its velocity change as the force and torque that make it, its grasp
+// rule's rate about the axis set directly (so that the dead band, on the rest of the torque, leaves
+// it), the dead band, the move, then the rule's turn.
+void Simulation::implicit_body_step(int b, TickRecord& record) {
   const BodyParams& bp = model_.bodies[b];
   BodyState& bs = state_.bodies[b];
   if (bs.asleep) {
@@ -119,16 +143,22 @@ void Simulation::implicit_body_step(int b, double pitch_change, TickRecord& reco
   }
   const double h = 1.0 / model_.rates.physics;
   BodyRecord& rec = record_state(b, floor_points_[b], record);
+  const AxisRule& rule = rules_[b];
+  Vec3 w0 = w0_[b];
+  if (rule.active) w0 += (rule.rate - w0.dot(rule.grasp.axis)) * rule.grasp.axis;
+  if (rule.grasp.held) rec.grasp_area = rule.grasp.area;
+  rec.torsion = rule.torsion;
+  rec.twist = rule.turn;
   const Mat3& R = bs.rotation;
   const Vec3 force = (bp.mass / h) * (implicit_.velocity(b) - v0_[b]);
-  Vec3 torque = (R * bp.inertia.asDiagonal() * R.transpose()) * ((implicit_.angular_velocity(b) - w0_[b]) / h);
-  bs.angular_velocity = w0_[b];
-  apply_grasp_rules(b, pitch_change, contact_wrench_[b], bs, torque, rec);
+  Vec3 torque = (R * bp.inertia.asDiagonal() * R.transpose()) * ((implicit_.angular_velocity(b) - w0) / h);
+  bs.angular_velocity = w0;
   dead_band(model_.grasp.dead_band, torque);
   rec.force = force;
   rec.torque = torque;
   mark_stepped(bs);
   move_body(bp, bs, force, torque, h);
+  turn_about_axis(rule.grasp, rule.turn, bs);
   finish_body_step(b, record);
 }
 

@@ -13,7 +13,7 @@ namespace {
 static_assert(sizeof(State) == 80, "State changed: update state_hash and its test");
 static_assert(sizeof(BodyState) == 328, "BodyState changed: update state_hash and its test");
 static_assert(sizeof(VertexContact) == 56, "VertexContact changed: update state_hash and its test");
-static_assert(sizeof(FingerState) == 216, "FingerState changed: update state_hash and its test");
+static_assert(sizeof(FingerState) == 240, "FingerState changed: update state_hash and its test");
 static_assert(sizeof(Features) == 16, "Features changed: update state_hash and its test");
 static_assert(sizeof(PairContact) == 1032, "PairContact changed: update state_hash and its test");
 static_assert(sizeof(PairPointContact) == 64, "PairPointContact changed: update state_hash and its test");
@@ -109,6 +109,7 @@ std::uint64_t state_hash(const State& s) {
     if (f.has_last_physics) {
       h.flag(f.has_last_physics);
       h.vec(f.hip_at_last_physics);
+      h.vec(f.window_force);
     }
   }
   h.size(s.pairs.size());

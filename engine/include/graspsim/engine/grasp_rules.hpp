@@ -51,6 +51,26 @@ double gravity_drop(const Model& model, int body, const TwoPointGrasp& grasp, do
 double gimbal_twist(const Model& model, int body, const TwoPointGrasp& grasp, double pitch_change,
                     BodyState& bs, Vec3& torque);
 
+// The same two rules for the implicit step, which cannot take a rate set after its solve: the
+// rule is planned before it, as the rate the body must turn at about the grasp axis (a
+// constraint of the solve, w1 . u = rate) and a turn to make after the move.
+struct AxisRule {
+  bool active = false;       // a two-point grasp under a torsion rule constrains the body
+  TwoPointGrasp grasp;       // u: grasp.axis, through grasp.go_first
+  double rate = 0.0;         // rad/s: w . u at the end of the step
+  double turn = 0.0;         // rad: rigid turn about the axis after the move (gimbal pitch, or
+                             //      the quasi-static gravity drop dt T_u / c_t)
+  double torsion = 0.0;      // N m: T_u, the gravity drop's torque about the axis (recorded)
+};
+// `contact_force` and `contact_torque` (about the centre of mass): the floor's and other
+// bodies' push at the start of the step, which turns the body about the axis with gravity.
+AxisRule plan_axis_rule(const Model& model, const State& state, int body, double dt, double pitch_change,
+                        const Vec3& contact_force, const Vec3& contact_torque);
+
+// Turns the body, orientation and centre, by `angle` about the grasp axis through the first
+// god-object (a rigid turn: the points on the axis stay put).
+void turn_about_axis(const TwoPointGrasp& grasp, double angle, BodyState& bs);
+
 // Section 5: T = 0 when |T| <= T_crit.
 inline void dead_band(double t_crit, Vec3& torque) {
   if (t_crit > 0.0 && torque.squaredNorm() <= t_crit * t_crit) torque.setZero();

@@ -61,10 +61,15 @@ class ImplicitStep {
   // (after the gyroscopic change), `wrench` the external force and torque on each body over the
   // step (gravity, fingers' window), `awake` which bodies move. Results: velocities(), mode(i)
   // and force(i) for every coupling, solved at the end of the step.
+  // `axis[b]`, where `axis_active[b]`, holds a body's rotation rate about a unit axis through
+  // `axis_point[b]` (m, world) at the end of the step: w1 . axis = axis_rate (a grasp rule's
+  // hinge), by a multiplier that turns the body about that line.
   void solve(const Model& model, const State& state, const std::vector<Coupling>& couplings,
              const std::vector<std::uint8_t>& awake, const std::vector<Vec3>& v0,
              const std::vector<Vec3>& w0, const std::vector<Vec3>& force,
-             const std::vector<Vec3>& torque, double h);
+             const std::vector<Vec3>& torque, const std::vector<std::uint8_t>& axis_active,
+             const std::vector<Vec3>& axis, const std::vector<Vec3>& axis_point,
+             const std::vector<double>& axis_rate, double h);
 
   const Vec3& velocity(int body) const { return v1_[body]; }            // m/s, world
   const Vec3& angular_velocity(int body) const { return w1_[body]; }    // rad/s, world
@@ -80,7 +85,9 @@ class ImplicitStep {
   int find(int body);
   void assemble_and_solve(const Model& model, const State& state, const std::vector<Coupling>& couplings,
                           const std::vector<Vec3>& v0, const std::vector<Vec3>& w0,
-                          const std::vector<Vec3>& force, const std::vector<Vec3>& torque, double h);
+                          const std::vector<Vec3>& force, const std::vector<Vec3>& torque,
+                          const std::vector<std::uint8_t>& axis_active, const std::vector<Vec3>& axis,
+                          const std::vector<Vec3>& axis_point, const std::vector<double>& axis_rate, double h);
   Vec3 relative_velocity(const State& state, const Coupling& c, const std::vector<Vec3>& v,
                          const std::vector<Vec3>& w) const;
 
@@ -91,8 +98,9 @@ class ImplicitStep {
   std::vector<int> island_start_;           // island i: island_bodies_[start[i], start[i+1])
   std::vector<int> island_couplings_;       // couplings grouped by island
   std::vector<int> coupling_start_;         // likewise for couplings
-  std::vector<double> matrix_;              // (6 n)^2, row-major: the island's system, then its factor
-  std::vector<double> rhs_;                 // 6 n: right side, then the solution
+  std::vector<double> matrix_;              // (7 n)^2, row-major: the island's system (6 per body, and
+                                            //    a row per axis constraint), then its factor
+  std::vector<double> rhs_;                 // 7 n: right side, then the solution
   std::vector<Vec3> v1_, w1_;               // per body: the solved velocities
   std::vector<CouplingMode> mode_;          // per coupling
   std::vector<Vec3> slide_;                 // 1, world, per coupling: unit direction of the sliding

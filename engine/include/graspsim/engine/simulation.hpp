@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "graspsim/engine/collision.hpp"
+#include "graspsim/engine/grasp_rules.hpp"
 #include "graspsim/engine/implicit_step.hpp"
 #include "graspsim/engine/model.hpp"
 #include "graspsim/engine/object_contact.hpp"
@@ -56,8 +57,8 @@ class Simulation {
   void paper_contacts();
   void paper_body_step(int b, double pitch_change, TickRecord& record);
   void implicit_contacts(const Input& input);
-  void implicit_solve();
-  void implicit_body_step(int b, double pitch_change, TickRecord& record);
+  void implicit_solve(double pitch_change);
+  void implicit_body_step(int b, TickRecord& record);
   void record_sleeping(int b, TickRecord& record);
   BodyRecord& record_state(int b, int floor_contacts, TickRecord& record);
   void apply_grasp_rules(int b, double pitch_change, const Wrench& contact, BodyState& bs, Vec3& torque,
@@ -72,8 +73,9 @@ class Simulation {
   bool collision_stale_ = false;   // bodies moved since collision_ was last updated
   std::vector<int> scratch_;   // candidate bodies of a finger query
   BodyContacts body_contacts_;            // body-body contact (its own broadphase)
-  std::vector<Wrench> contact_wrench_;    // per body: floor and body-body contact wrench of this step
-                                          //   (paper: body-body only; the floor's is added per body)
+  std::vector<Wrench> contact_wrench_;    // per body: the contact wrench the grasp rules see (paper:
+                                          //   body-body, the floor's added per body; implicit: floor
+                                          //   and bodies at the start of the step, pushing only)
   std::vector<int> contact_points_;       // per body: body-body contact points of this step
   std::vector<double> floor_reach_;       // m, per body: farthest floor point from the centre of mass
   std::vector<std::uint8_t> floor_clear_;  // per body: 1 when none of its floor points is active
@@ -88,6 +90,11 @@ class Simulation {
   std::vector<int> floor_points_;         // per body: floor points pushing at the end of the step
   std::vector<Vec3> finger_point_;        // m, world, per finger: contact point of this servo tick
   std::vector<Vec3> finger_force_;        // N, world, per finger: force on the finger this servo tick
+  std::vector<AxisRule> rules_;           // per body: its grasp rule this step
+  std::vector<std::uint8_t> axis_active_; // per body: 1 when a rule holds its rate about an axis
+  std::vector<Vec3> axis_;                // 1, world, per body: that axis
+  std::vector<Vec3> axis_point_;          // m, world, per body: a point of it (the first god-object)
+  std::vector<double> axis_rate_;         // rad/s, per body: the rate about it at the end of the step
 };
 
 }  // namespace graspsim

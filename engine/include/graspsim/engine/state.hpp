@@ -42,6 +42,8 @@ struct FingerState {
   bool has_pitch = false;                   // false until the first physics step
   Vec3 hip_at_last_physics{0.0, 0.0, 0.0};  // m, world: HIP at the previous physics step (implicit
                                             //    integrator: the HIP's velocity over the window)
+  Vec3 window_force{0.0, 0.0, 0.0};         // N, world: this finger's force on its body summed over
+                                            //    the current physics window (implicit integrator)
   bool has_last_physics = false;            // false until the first physics step (always, under
                                             //    the paper's integrator, which does not use it)
 };
