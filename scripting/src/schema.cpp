@@ -616,6 +616,7 @@ ScenarioParts convert_scenario(const LuaValue& root, const std::string& default_
     s.seed = static_cast<std::uint64_t>(value);
   }
   s.model.gravity = r.vec3_or("gravity", s.model.gravity);
+  s.model.integrator = Integrator::kImplicit;   // the scenario format's default (README, "Integrators")
   if (const LuaValue* i = r.get("integrator")) {
     const std::string name = choice(*i, r.at("integrator"), {"paper", "implicit"}, "integrator");
     s.model.integrator = name == "paper" ? Integrator::kPaper : Integrator::kImplicit;

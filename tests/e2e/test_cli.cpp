@@ -112,7 +112,7 @@ TEST_CASE("an unstable grasp is warned of with its time, and refused on request"
   const std::string mode = "at 50 Hz the paper's explicit step of 'rod' on finger 'thumb' and finger 'index' "
                            "has spectral radius 3.89";
   const std::string warned = kTmp + "/cli_stability_warn.h5";
-  const Outcome w = cli("run " + scenario + " --quiet --out " + warned);
+  const Outcome w = cli("run " + scenario + " --quiet --set integrator=paper --out " + warned);
   INFO(w.output);
   CHECK(w.status == 0);
   CHECK_THAT(w.output, Catch::Contains("graspsim: warning: t = 0.000 s (tick 0): " + mode));
@@ -120,7 +120,7 @@ TEST_CASE("an unstable grasp is warned of with its time, and refused on request"
   CHECK(graspsim::recordings::read_string_attribute(warned, "/", "warnings").find("t = 0.000 s (tick 0): " + mode) == 0);
   for (const std::string& refuse : {std::string("--refuse-unstable"), std::string("--set stability=refuse")}) {
     const std::string refused = kTmp + "/cli_stability_refuse.h5";
-    const Outcome r = cli("run " + scenario + " --quiet " + refuse + " --out " + refused);
+    const Outcome r = cli("run " + scenario + " --quiet --set integrator=paper " + refuse + " --out " + refused);
     INFO(refuse << "\n" << r.output);
     CHECK(r.status == 2);
     CHECK_THAT(r.output, Catch::Contains("the run stopped early: the stability check refused to go on: "
@@ -128,7 +128,7 @@ TEST_CASE("an unstable grasp is warned of with its time, and refused on request"
     const std::string status = graspsim::recordings::read_string_attribute(refused, "/", "status");
     CHECK_THAT(status, Catch::StartsWith("error: the stability check refused to go on") && Catch::Contains(mode));
   }
-  for (const std::string& stable : {std::string("--set rates.physics=100"), std::string("--set integrator=implicit")}) {
+  for (const std::string& stable : {std::string("--set integrator=paper --set rates.physics=100"), std::string("")}) {
     const Outcome o = cli("run " + scenario + " --quiet --refuse-unstable " + stable + " --out " + kTmp +
                           "/cli_stability_stable.h5");
     INFO(stable << "\n" << o.output);

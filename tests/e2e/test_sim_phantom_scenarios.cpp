@@ -111,8 +111,8 @@ Outcome run_on_sim_phantom(const std::string& scenario_name, const std::string& 
 // Phantom" has the table and why each other one does not. All of them: about 1 s of CPU.
 TEST_CASE("Library scenarios a Phantom can perform meet their expectations with every finger on sim-phantom",
           "[e2e][devices][sim_phantom]") {
-  for (const char* name : {"gravity_drop", "heavy_hold", "pole_balance", "push_along_floor", "rod_swing",
-                           "stack_lift", "stack_mass_ratio", "two_finger_lift"}) {
+  for (const char* name : {"gimbal_twist", "handle_lift", "heavy_hold", "mesh_grasp", "pole_balance",
+                           "push_along_floor", "stack_lift", "stack_mass_ratio", "two_finger_lift"}) {
     const Outcome o = run_on_sim_phantom(name, "sim-phantom", "library");
     INFO(name << " with every finger on sim-phantom: " << o.result.error);
     for (const auto& e : o.result.expectations) {

@@ -101,7 +101,7 @@ struct Run {
 };
 
 Run run(const std::string& name, int physics, bool disturbed) {
-  std::vector<std::string> sets;
+  std::vector<std::string> sets = {"integrator=paper"};   // the scheme the check watches
   if (physics > 0) sets.push_back("rates.physics=" + std::to_string(physics));
   // The disturbance: each body spun by 0.01 rad/s at t = 0 and each finger 0.1 mm off its path
   // (a direction of its own), the size of one encoder count of a real device's offset.

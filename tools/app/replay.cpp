@@ -175,6 +175,9 @@ ReplayPlan load(const std::string& trace, const ReplayOptions& options) {
   plan.scenario_source_hash = required_string(trace, "scenario_source_hash");
   const std::string source = required_string(trace, "scenario_source");
   plan.overrides = split_lines(required_string(trace, "overrides"));
+  // A trace without `integrator` comes from before the implicit step, when every run used the
+  // paper's: it replays with it (first, so that a --set integrator= still wins).
+  if (!recordings::has_attribute(trace, "/", "integrator")) plan.overrides.insert(plan.overrides.begin(), "integrator=paper");
   plan.overrides.insert(plan.overrides.end(), options.sets.begin(), options.sets.end());
   plan.what_if = !options.sets.empty();
 

@@ -232,6 +232,7 @@ app::RunResult run_for_golden(const std::string& scenario_file, const std::strin
   const auto scenario = scripting::Scenario::load(scenario_file, load);
   app::RunOptions options;
   options.out = trace;
+  options.overrides = load.sets;   // recorded, so that a replay of the trace runs the same step
   return app::run_scenario(scenario, options);
 }
 
