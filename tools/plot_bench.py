@@ -5,7 +5,10 @@
                                 DIR/work_precision.png and DIR/stability.png
 
 work_precision.png: error against cost (wall seconds per simulated second), log-log, one panel
-per case and one curve per gyroscopic option, each point labelled with its physics rate in Hz.
+per case and one curve per gyroscopic option (the hard cases) or per integration scheme, paper or
+implicit (the contact accuracy cases, whose rows differ in `scheme`), each point labelled with its
+physics rate in Hz. Rows a model was refused for (status "refused: ...") have no cost and are left
+out.
 Unstable runs are drawn as red crosses (at the panel's top edge when their error is not finite);
 the finest rate of a convergence case is its own reference (error 0) and is left out.
 stability.png: the corner drop's largest stable floor stiffness against the physics rate, with
@@ -22,6 +25,17 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
 STYLE = {"neglect": ("tab:blue", "o"), "explicit": ("tab:orange", "s"), "implicit": ("tab:green", "^")}
+SCHEME_STYLE = {"paper": ("tab:red", "D"), "implicit": ("tab:purple", "v")}
+# The contact accuracy targets, in each case's error unit (tools/bench/README.md, "Contact accuracy").
+TARGETS = {"cube_rest": 1e-4, "slope_stick": 1e-5, "slope_slide": 0.005, "cube_settle": 1e-4}
+
+
+def curves(rows):
+    """(column, value, label, colour, marker) of each curve of a panel: by scheme where its rows
+    have more than one, else by gyroscopic option."""
+    if len({r.get("scheme", "") for r in rows}) > 1:
+        return [("scheme", k, f"{k} scheme", c, m) for k, (c, m) in SCHEME_STYLE.items()]
+    return [("integrator", k, f"gyroscopic {k}", c, m) for k, (c, m) in STYLE.items()]
 
 
 def fail(message):
@@ -55,15 +69,21 @@ def work_precision(rows, out):
     nrows = (len(cases) + cols - 1) // cols
     fig, axes = plt.subplots(nrows, cols, figsize=(5.2 * cols, 4.0 * nrows), squeeze=False)
     for ax, case in zip(axes.flat, cases):
-        mine = [r for r in rows if r["case"] == case]
+        every = [r for r in rows if r["case"] == case]
+        mine = [r for r in every if not r["status"].startswith("refused")]
+        refused = []
         finite = [number(r["error"]) for r in mine if 0 < number(r["error"]) < math.inf]
         top = max(finite) * 3 if finite else 1.0
-        for integrator, (colour, marker) in STYLE.items():
-            pts = [r for r in mine if r["integrator"] == integrator and number(r["error"]) != 0]
+        for column, key, label, colour, marker in curves(every):
+            pts = [r for r in mine if r.get(column) == key and number(r["error"]) != 0]
             pts.sort(key=lambda r: int(r["rate_hz"]))
             ok = [r for r in pts if r["status"] == "ok"]
+            if not pts:
+                if any(r.get(column) == key for r in every):
+                    refused.append(label)
+                continue
             ax.plot([number(r["wall_per_sim_s"]) for r in ok], [number(r["error"]) for r in ok],
-                    marker=marker, color=colour, label=integrator, linewidth=1, markersize=5)
+                    marker=marker, color=colour, label=label, linewidth=1, markersize=5)
             # The spread of the repeats (min to max wall time): where it is as wide as the steps
             # between rates, the order of the points along x is noise, not cost.
             spread = [r for r in ok if r.get("wall_min") and r.get("wall_max")]
@@ -81,6 +101,11 @@ def work_precision(rows, out):
                     ax.plot([x], [y], marker="x", color="red", markersize=8, markeredgewidth=2, linestyle="none")
                 ax.annotate(r["rate_hz"], (x, y), textcoords="offset points", xytext=(3, 3), fontsize=6,
                             color=colour)
+        if case in TARGETS:
+            ax.axhline(TARGETS[case], color="grey", linestyle="--", linewidth=1, label="target")
+        if refused:
+            ax.text(0.02, 0.02, "refused by validate(): " + ", ".join(refused), transform=ax.transAxes,
+                    fontsize=7, color="grey")
         ax.set_xscale("log")
         ax.set_yscale("log")
         costs = [number(r["wall_per_sim_s"]) for r in mine if r["status"] == "ok" and number(r["error"]) != 0]
@@ -97,10 +122,15 @@ def work_precision(rows, out):
         ax.grid(True, which="both", linewidth=0.3)
     for ax in list(axes.flat)[len(cases):]:
         ax.axis("off")
-    handles, labels = axes.flat[0].get_legend_handles_labels()
+    handles, labels = [], []
+    for ax in axes.flat:
+        for h, label in zip(*ax.get_legend_handles_labels()):
+            if label not in labels:
+                handles.append(h)
+                labels.append(label)
     handles.append(plt.Line2D([], [], marker="x", color="red", linestyle="none", markeredgewidth=2))
     labels.append("unstable")
-    fig.legend(handles, labels, loc="lower center", ncol=4, fontsize=8)
+    fig.legend(handles, labels, loc="lower center", ncol=min(len(labels), 6), fontsize=8)
     fig.suptitle("graspsim work-precision (labels: physics rate, Hz)", fontsize=11)
     fig.tight_layout(rect=(0, 0.05, 1, 0.96))
     fig.savefig(out, dpi=80)

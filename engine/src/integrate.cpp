@@ -114,4 +114,25 @@ void integrate_body(const BodyParams& params, Gyroscopic gyroscopic, BodyState& 
   orthonormalize(body.rotation);
 }
 
+Vec3 gyroscopic_change(const BodyParams& params, Gyroscopic gyroscopic, const BodyState& body, double dt) {
+  if (gyroscopic == Gyroscopic::kNeglect) return Vec3::Zero();
+  const Mat3& R = body.rotation;
+  const Vec3 w_b = R.transpose() * body.angular_velocity;   // rad/s, body frame
+  const Vec3 dw_b = gyroscopic == Gyroscopic::kExplicit ? gyroscopic_explicit(params.inertia, w_b, dt)
+                                                        : gyroscopic_implicit(params.inertia, w_b, dt);
+  return R * dw_b;
+}
+
+void move_body(const BodyParams& params, BodyState& body, const Vec3& force, const Vec3& torque, double dt) {
+  body.velocity += force * (dt / params.mass);
+  body.position += dt * body.velocity;
+
+  const Mat3 R = body.rotation;
+  body.angular_velocity += dt * (R * (R.transpose() * torque).cwiseQuotient(params.inertia));
+  const Vec3& w = body.angular_velocity;   // rad/s
+  const double angle = w.norm() * dt;      // rad
+  if (angle > 0.0) body.rotation = Eigen::AngleAxisd(angle, w / w.norm()).toRotationMatrix() * R;
+  orthonormalize(body.rotation);
+}
+
 }  // namespace graspsim

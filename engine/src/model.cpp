@@ -81,6 +81,29 @@ ContactPair contact_pair(const Material& a, const Material& b) {
                      std::max(a.viscous, b.viscous)};
 }
 
+ContactPair with_default_law(const ContactPair& pair, double mass, int physics_rate) {
+  ContactPair out = pair;
+  const double omega = 4.0 * M_PI * physics_rate;   // rad/s: a natural period of half a step
+  if (std::isinf(out.stiffness)) out.stiffness = mass * omega * omega;
+  if (std::isinf(out.damping)) out.damping = 2.0 * std::sqrt(out.stiffness * mass);
+  return out;
+}
+
+ContactPair floor_pair(const Model& model, int body) {
+  const BodyParams& bp = model.bodies[body];
+  const ContactPair pair = contact_pair(bp.material, model.floor.material);
+  if (model.integrator == Integrator::kPaper) return pair;
+  return with_default_law(pair, bp.mass, model.rates.physics);
+}
+
+ContactPair body_pair(const Model& model, int a, int b) {
+  const BodyParams& pa = model.bodies[a];
+  const BodyParams& pb = model.bodies[b];
+  const ContactPair pair = contact_pair(pa.material, pb.material);
+  if (model.integrator == Integrator::kPaper) return pair;
+  return with_default_law(pair, pa.mass * pb.mass / (pa.mass + pb.mass), model.rates.physics);
+}
+
 Divisors divisors(const Rates& r) {
   return Divisors{r.servo / r.haptic, r.servo / r.physics};
 }
@@ -202,14 +225,16 @@ void validate(const Model& model) {
     if (!finite(b.position) || !finite(b.velocity) || !finite(b.angular_velocity) || !b.orientation.coeffs().allFinite())
       fail(f, "initial position, orientation and velocities must be finite");
     if (std::abs(b.orientation.norm() - 1.0) > 1e-9) fail(f + ": orientation", "must be a unit quaternion");
-    if (model.floor.enabled) {
+    if (model.floor.enabled && model.integrator == Integrator::kPaper) {
       const ContactPair pair = contact_pair(b.material, model.floor.material);
       if (std::isinf(pair.stiffness))
         fail(f + ": material.stiffness", "the object and the floor are both rigid (infinite "
-             "stiffness); the penalty floor contact needs a finite stiffness on one of them");
+             "stiffness); the paper's penalty floor contact needs a finite stiffness on one of them "
+             "(integrator = \"implicit\" chooses one)");
       if (std::isinf(pair.damping))
         fail(f + ": material.damping", "the object and the floor both leave damping unset "
-             "(infinite); the penalty floor contact needs a finite damping on one of them (0 for none)");
+             "(infinite); the paper's penalty floor contact needs a finite damping on one of them (0 for "
+             "none; integrator = \"implicit\" chooses one)");
     }
   }
   names.clear();

@@ -123,6 +123,59 @@ int floor_contact(const Model& model, int body, BodyState& bs, Wrench& out) {
   return touching;
 }
 
+int floor_couplings(const Model& model, int body, BodyState& bs, double h, std::vector<Coupling>& out) {
+  const BodyParams& bp = model.bodies[body];
+  const ContactPair pair = floor_pair(model, body);
+  const double floor_z = model.floor.height;
+  const double reach = h * h * model.gravity.norm();   // m: how far gravity alone carries a point in a step
+  int appended = 0;
+  const int count = static_cast<int>(bs.floor_contacts.size());
+  for (int k = 0; k < count; ++k) {
+    VertexContact& vc = bs.floor_contacts[k];
+    bool rolling = false;
+    const Vec3 r = floor_point(bp.shape, bs.rotation, k, rolling);   // m: from centre of mass
+    const Vec3 x = bs.position + r;
+    const double depth = floor_z - x.z();                            // m: < 0 above the floor
+    const Vec3 u = bs.velocity + bs.angular_velocity.cross(r);       // m/s
+    if (depth <= -(h * std::max(0.0, -u.z()) + reach)) {
+      vc.active = false;
+      continue;
+    }
+    const Vec3 x_m = (rolling && vc.active) ? Vec3(bs.position + bs.rotation * vc.material) : x;
+    const Vec3 x_t(x_m.x(), x_m.y(), floor_z);
+    if (!vc.active) {
+      vc.active = true;
+      vc.slipping = false;
+      vc.anchor = x_t;
+    }
+    const Vec3 u_t(u.x(), u.y(), 0.0);                 // m/s
+    const double f_n = pair.stiffness * depth - pair.damping * u.z();   // N, unclamped
+    const double viscous = pair.viscous * u_t.norm();   // N, while slipping
+    vc.slipping = stick_slip_step(x_t, pair.mu * std::max(0.0, f_n) / pair.stiffness,
+                                  (pair.friction(true) * std::max(0.0, f_n) + viscous) / pair.stiffness, u_t,
+                                  vc.slipping, vc.anchor);
+    Coupling c;
+    c.source = Coupling::Source::kFloor;
+    c.slot = k;
+    c.a = -1;
+    c.b = body;
+    c.point = x;
+    c.normal = Vec3::UnitZ();
+    c.force = pair.stiffness * (vc.anchor - x_t) - pair.damping * u_t + Vec3(0.0, 0.0, f_n);
+    c.k_n = c.k_t = pair.stiffness;
+    c.c_n = c.c_t = pair.damping;
+    c.mu = pair.friction(vc.slipping);
+    c.viscous = vc.slipping ? viscous : 0.0;
+    out.push_back(c);
+    ++appended;
+    if (rolling) {   // carry the stretch over to the new lowest point and its material
+      vc.anchor = Vec3(x.x(), x.y(), floor_z) + (vc.anchor - x_t);
+      vc.material = bs.rotation.transpose() * r;
+    }
+  }
+  return appended;
+}
+
 // ---- body against body ----
 
 namespace {
@@ -411,7 +464,7 @@ BodyContacts::BodyContacts(BodyContacts&&) noexcept = default;
 BodyContacts& BodyContacts::operator=(BodyContacts&&) noexcept = default;
 
 int BodyContacts::points(const Model& model, const State& state, int a, int b, ManifoldPoint* out) {
-  if (!collides(contact_pair(model.bodies[a].material, model.bodies[b].material))) return 0;
+  if (!collides(body_pair(model, a, b))) return 0;
   impl_->update(state);
   const int n = impl_->find(state, a, b);
   std::copy(impl_->found.begin(), impl_->found.begin() + n, out);
@@ -419,6 +472,15 @@ int BodyContacts::points(const Model& model, const State& state, int a, int b, M
 }
 
 void BodyContacts::step(const Model& model, State& state, std::vector<Wrench>& wrenches, std::vector<int>& points) {
+  run(model, state, &wrenches, points, nullptr);
+}
+
+void BodyContacts::couplings(const Model& model, State& state, std::vector<Coupling>& out, std::vector<int>& points) {
+  run(model, state, nullptr, points, &out);
+}
+
+void BodyContacts::run(const Model& model, State& state, std::vector<Wrench>* wrenches, std::vector<int>& points,
+                       std::vector<Coupling>* out) {
   Impl& im = *impl_;
   const int nb = static_cast<int>(model.bodies.size());
   if (nb < 2) return;
@@ -445,7 +507,7 @@ void BodyContacts::step(const Model& model, State& state, std::vector<Wrench>& w
   }
 
   for (const auto& [a, b] : im.candidates) {
-    const ContactPair cp = contact_pair(model.bodies[a].material, model.bodies[b].material);
+    const ContactPair cp = body_pair(model, a, b);
     if (!collides(cp)) continue;
     const std::size_t pi = pair_index(a, b, nb);
     im.touched[pi] = 1;
@@ -489,21 +551,37 @@ void BodyContacts::step(const Model& model, State& state, std::vector<Wrench>& w
       pp.slipping = stick_slip_step(anchor_b, cp.mu * f_n / cp.stiffness,
                                     (cp.friction(true) * f_n + viscous) / cp.stiffness, v_t, pp.slipping, anchor_a);
       const Vec3 stretch = anchor_a - anchor_b;   // m: pulls B's material towards A's anchor
-      Vec3 f_t = cp.stiffness * stretch - cp.damping * v_t;
-      const double limit = cp.friction(pp.slipping) * f_n + (pp.slipping ? viscous : 0.0);
-      const double f_t_norm = f_t.norm();
-      if (f_t_norm > limit) f_t *= limit / f_t_norm;
-      const Vec3 f = f_n * nrm + f_t;   // N on B; -f on A, at the same point
-      wrenches[b].force += f;
-      wrenches[b].torque += rb.cross(f);
-      wrenches[a].force -= f;
-      wrenches[a].torque -= ra.cross(f);
       ++points[a];
       ++points[b];
       // Keep the stretch, re-based at this point (the point may move over the bodies).
       pp.anchor_b = sb.rotation.transpose() * (mp.point - sb.position);
       pp.anchor_a = sa.rotation.transpose() * (mp.point + stretch - sa.position);
       im.next[i] = pp;
+      if (out != nullptr) {   // the implicit step: the law unclamped, solved with the bodies
+        Coupling c;
+        c.source = Coupling::Source::kBody;
+        c.slot = i;
+        c.a = a;
+        c.b = b;
+        c.point = mp.point;
+        c.normal = nrm;
+        c.force = (cp.stiffness * mp.depth - cp.damping * vn) * nrm + cp.stiffness * stretch - cp.damping * v_t;
+        c.k_n = c.k_t = cp.stiffness;
+        c.c_n = c.c_t = cp.damping;
+        c.mu = cp.friction(pp.slipping);
+        c.viscous = pp.slipping ? viscous : 0.0;
+        out->push_back(c);
+        continue;
+      }
+      Vec3 f_t = cp.stiffness * stretch - cp.damping * v_t;
+      const double limit = cp.friction(pp.slipping) * f_n + (pp.slipping ? viscous : 0.0);
+      const double f_t_norm = f_t.norm();
+      if (f_t_norm > limit) f_t *= limit / f_t_norm;
+      const Vec3 f = f_n * nrm + f_t;   // N on B; -f on A, at the same point
+      (*wrenches)[b].force += f;
+      (*wrenches)[b].torque += rb.cross(f);
+      (*wrenches)[a].force -= f;
+      (*wrenches)[a].torque -= ra.cross(f);
     }
     std::copy(im.next.begin(), im.next.begin() + n, pc.points.begin());
     pc.count = n;

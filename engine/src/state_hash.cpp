@@ -13,7 +13,7 @@ namespace {
 static_assert(sizeof(State) == 80, "State changed: update state_hash and its test");
 static_assert(sizeof(BodyState) == 328, "BodyState changed: update state_hash and its test");
 static_assert(sizeof(VertexContact) == 56, "VertexContact changed: update state_hash and its test");
-static_assert(sizeof(FingerState) == 184, "FingerState changed: update state_hash and its test");
+static_assert(sizeof(FingerState) == 216, "FingerState changed: update state_hash and its test");
 static_assert(sizeof(Features) == 16, "Features changed: update state_hash and its test");
 static_assert(sizeof(PairContact) == 1032, "PairContact changed: update state_hash and its test");
 static_assert(sizeof(PairPointContact) == 64, "PairPointContact changed: update state_hash and its test");
@@ -105,6 +105,11 @@ std::uint64_t state_hash(const State& s) {
     h.real(f.friction_radius);
     h.real(f.pitch_at_last_physics);
     h.flag(f.has_pitch);
+    // Only once set (implicit integrator), so that paper traces keep the hash they always had.
+    if (f.has_last_physics) {
+      h.flag(f.has_last_physics);
+      h.vec(f.hip_at_last_physics);
+    }
   }
   h.size(s.pairs.size());
   for (const PairContact& p : s.pairs) {

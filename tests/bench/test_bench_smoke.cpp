@@ -1,13 +1,15 @@
 // CI smoke run of the work-precision benchmark (README.md, "Speed against error"): graspsim_bench
 // --quick runs, exits 0, and writes bench.csv and stability.csv with the expected columns, one
-// row per case x rate x integrator, and finite numbers where they must be. Its times are not
-// checked (a shared CI machine times nothing reliably); only that they are positive and finite.
+// row per case x rate x gyroscopic option (the hard cases) or x scheme (the contact accuracy
+// cases), finite numbers where they must be, and prints the contact accuracy table. Its times are
+// not checked (a shared CI machine times nothing reliably); only that they are positive and finite.
 #include <catch2/catch.hpp>
 
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <set>
 #include <sstream>
 #include <string>
@@ -51,16 +53,18 @@ TEST_CASE("graspsim_bench --quick writes the work-precision CSV and the stabilit
   const std::vector<std::string> header{"case", "rate_hz", "integrator", "status", "wall_per_sim_s", "wall_min",
                                         "wall_max", "cpu_per_sim_s", "repeats", "error", "error_measure", "energy_drift",
                                         "momentum_drift", "period_s", "period_ref_s", "precession_rad_s",
-                                        "precession_ref_rad_s", "note"};
+                                        "precession_ref_rad_s", "note", "scheme"};
   REQUIRE(bench[0] == header);
-  // 4 cases x 3 rates (quick: 50, 500, 3000 Hz) x 3 integrators, each once.
-  CHECK(bench.size() == 1 + 4 * 3 * 3);
+  // 4 hard cases x 3 rates (quick: 50, 500, 3000 Hz) x 3 gyroscopic options, and 4 contact
+  // accuracy cases x 3 rates x 2 schemes, each once.
+  CHECK(bench.size() == 1 + 4 * 3 * 3 + 4 * 3 * 2);
+  const std::set<std::string> contact{"cube_rest", "slope_stick", "slope_slide", "cube_settle"};
   std::set<std::string> seen;
   for (std::size_t i = 1; i < bench.size(); ++i) {
     const auto& r = bench[i];
     INFO("row " << i << ": " << r[0] << " " << r[1] << " Hz " << r[2] << " " << r[3]);
     REQUIRE(r.size() == header.size());
-    CHECK(seen.insert(r[0] + "/" + r[1] + "/" + r[2]).second);
+    CHECK(seen.insert(r[0] + "/" + r[1] + "/" + r[2] + "/" + r[18]).second);
     CHECK(finite_number(r[1]));
     CHECK((r[2] == "neglect" || r[2] == "explicit" || r[2] == "implicit"));
     CHECK((r[3] == "ok" || r[3].rfind("unstable: ", 0) == 0));
@@ -71,7 +75,14 @@ TEST_CASE("graspsim_bench --quick writes the work-precision CSV and the stabilit
     CHECK(r[8] == "1");
     if (r[3] == "ok") CHECK(finite_number(r[9]));   // an unstable run may have an infinite error
     CHECK(!r[10].empty());
+    CHECK((r[18] == "paper" || r[18] == "implicit"));
+    // The schemes of the contact scenes both run (the status is "ok" or "unstable: ...", never
+    // "refused: ..."): the implicit one accepts unset stiffness, the paper one has its soft floor.
+    if (contact.count(r[0])) CHECK(finite_number(r[9]));
   }
+  std::ifstream log(dir + ".log");
+  const std::string printed((std::istreambuf_iterator<char>(log)), std::istreambuf_iterator<char>());
+  CHECK(printed.find("contact accuracy: 10 cm, 1 kg cube") != std::string::npos);
   const auto stab = read_csv(dir + "/stability.csv");
   REQUIRE(stab.size() == 1 + 3 * 3);
   CHECK(stab[0] == std::vector<std::string>{"rate_hz", "integrator", "k_max_n_per_m", "estimate_n_per_m"});

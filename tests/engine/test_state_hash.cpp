@@ -67,6 +67,8 @@ State sample_state() {
     f.friction_radius = next();
     f.pitch_at_last_physics = next();
     f.has_pitch = true;
+    f.hip_at_last_physics = vec();
+    f.has_last_physics = true;
   }
   s.pairs.resize(1);
   s.pairs[0].count = 3;
@@ -141,6 +143,8 @@ std::vector<Mutation> mutations() {
     add(p + "friction_radius", [f](State& s) { s.fingers[f].friction_radius += 1.0; });
     add(p + "pitch_at_last_physics", [f](State& s) { s.fingers[f].pitch_at_last_physics += 1.0; });
     add(p + "has_pitch", [f](State& s) { s.fingers[f].has_pitch ^= true; });
+    add_vec(p + "hip_at_last_physics", [f](State& s) -> Vec3& { return s.fingers[f].hip_at_last_physics; });
+    add(p + "has_last_physics", [f](State& s) { s.fingers[f].has_last_physics ^= true; });
   }
   add("fingers (one more)", [](State& s) { s.fingers.emplace_back(); });
   add("pairs[0].count", [](State& s) { ++s.pairs[0].count; });
@@ -182,7 +186,7 @@ TEST_CASE("changing any one field of the state changes its hash", "[state_hash]"
   const auto all = mutations();
   // tick, 2 bodies x 56 scalars (54 + asleep, still_steps) (+ a floor point), the body count, 2 fingers x 27, the finger
   // count, pair count, 16 points x 8, the pair count: every field is visited.
-  REQUIRE(all.size() == 1 + 2 * 56 + 1 + 2 * 27 + 1 + 1 + 16 * 8 + 1);
+  REQUIRE(all.size() == 1 + 2 * 56 + 1 + 2 * 31 + 1 + 1 + 16 * 8 + 1);
   std::vector<std::uint64_t> seen{h0};
   for (const auto& [name, mutate] : all) {
     State s = base;

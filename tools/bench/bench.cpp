@@ -1,14 +1,14 @@
-// graspsim_bench: the work-precision benchmark of issue 5 (README.md, "Speed against error").
-// For every case x physics rate x gyroscopic option: the wall time per simulated second (median
-// of --repeats runs in this process, after one warm-up run that is dropped) and the error against
-// the analytic solution or, where there is none, against the same case at the finest rate.
-// Writes OUT/bench.csv and OUT/stability.csv and prints both as tables. Not a test: it times.
+// graspsim_bench: the work-precision benchmark (README.md, "Speed against error").
+// For every case x physics rate x gyroscopic option (the hard cases) or x integration scheme (the
+// contact accuracy cases, accuracy.hpp): the wall time per simulated second (median of --repeats
+// runs in this process, after one warm-up run that is dropped) and the error against the analytic
+// solution or, where there is none, against the same case at the finest rate.
+// Writes OUT/bench.csv and OUT/stability.csv and prints them and the contact accuracy figures as
+// tables. Not a test: it times.
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
-#include <ctime>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -17,18 +17,22 @@
 #include <string>
 #include <vector>
 
+#include "bench/accuracy.hpp"
 #include "bench/cases.hpp"
 #include "bench/lift.hpp"
 #include "bench/robustness_case.hpp"
+#include "bench/row.hpp"
 
 using namespace graspsim;
 using namespace graspsim::bench;
 
 namespace {
 
-using Clock = std::chrono::steady_clock;
-
-const std::vector<std::string> kCases{"spin_flip", "gyro_precession", "corner_drop", "two_finger_lift"};
+const std::vector<std::string> kCases = [] {
+  std::vector<std::string> c{"spin_flip", "gyro_precession", "corner_drop", "two_finger_lift"};
+  c.insert(c.end(), kAccuracyCases.begin(), kAccuracyCases.end());
+  return c;
+}();
 // Cases run only when --cases names them: robustness runs thousands of scenarios (minutes).
 const std::vector<std::string> kOnRequest{"robustness"};
 constexpr double kSpinEnergyGainBound = 0.05;   // 1: relative energy gain over 10 s that marks a
@@ -45,35 +49,12 @@ struct Options {
   RobustnessOptions robustness;   // --seeds, --jitter, --set, --scenarios
 };
 
-struct Row {
-  std::string name;
-  int rate = 0;
-  Gyroscopic g = Gyroscopic::kNeglect;
-  std::string status = "ok";
-  double cost = 0.0, cost_min = 0.0, cost_max = 0.0;   // s wall per s simulated
-  double cpu = 0.0;                                    // s of this thread's CPU per s simulated
-  int repeats = 0;
-  double error = 0.0;
-  std::string measure;
-  // Case details, NaN where they do not apply (empty in the CSV).
-  double energy_drift = NAN, momentum_drift = NAN, period = NAN, period_ref = NAN;
-  double precession = NAN, precession_ref = NAN;
-  std::string note;
-};
-
-Row make_row(const std::string& name, int rate, Gyroscopic g) {
-  Row r;
-  r.name = name;
-  r.rate = rate;
-  r.g = g;
-  return r;
-}
-
 [[noreturn]] void usage(const std::string& error) {
   std::cerr << "graspsim_bench: " << error << "\n"
             << "usage: graspsim_bench [--quick] [--repeats N] [--out DIR] [--cases a,b,...] [--lift FILE.lua]\n"
             << "                      [--seeds N] [--jitter M] [--set NAME=VALUE]... [--scenarios a,b,...]\n"
-            << "cases: spin_flip, gyro_precession, corner_drop, two_finger_lift (the default: all four);\n"
+            << "cases: spin_flip, gyro_precession, corner_drop, two_finger_lift, cube_rest, slope_stick, slope_slide,\n"
+            << "       cube_settle (the default: all of them);\n"
             << "       robustness (only when named: --seeds jitter seeds per scenario, default 100, --quick 5;\n"
             << "       --jitter amplitude in m, default 0.5e-3; --set for every run; --scenarios a subset)\n";
   std::exit(2);
@@ -134,49 +115,6 @@ Options parse(int argc, char** argv) {
   o.robustness.scenario_dir = GRASPSIM_SOURCE_DIR "/scenarios";
   o.robustness.out = o.out;
   return o;
-}
-
-// Times `run` (a whole simulated run of `simulated` s): one warm-up call, dropped, then `repeats`
-// timed calls; fills the row's cost (median, min, max wall seconds per simulated second) and
-// the median CPU time of this thread per simulated second (less sensitive to a loaded machine:
-// time the scheduler gave to other processes is not counted).
-double thread_cpu_seconds() {
-  timespec ts{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
-}
-
-double median(std::vector<double> t) {
-  std::sort(t.begin(), t.end());
-  const std::size_t n = t.size();
-  return n % 2 ? t[n / 2] : 0.5 * (t[n / 2 - 1] + t[n / 2]);
-}
-
-template <class Run>
-void time_it(Row& row, int repeats, double simulated, Run&& run) {
-  run();   // warm-up: caches, page faults, first allocations
-  std::vector<double> t, cpu;
-  for (int i = 0; i < repeats; ++i) {
-    const double cpu_start = thread_cpu_seconds();
-    const auto start = Clock::now();
-    run();
-    t.push_back(std::chrono::duration<double>(Clock::now() - start).count() / simulated);
-    cpu.push_back((thread_cpu_seconds() - cpu_start) / simulated);
-  }
-  row.cpu = median(cpu);
-  std::sort(t.begin(), t.end());
-  const std::size_t n = t.size();
-  row.cost = n % 2 ? t[n / 2] : 0.5 * (t[n / 2 - 1] + t[n / 2]);
-  row.cost_min = t.front();
-  row.cost_max = t.back();
-  row.repeats = repeats;
-}
-
-std::string num(double v) {
-  if (std::isnan(v)) return "";
-  char b[32];
-  std::snprintf(b, sizeof b, "%.6g", v);
-  return b;
 }
 
 }  // namespace
@@ -276,7 +214,7 @@ int main(int argc, char** argv) {
     for (Gyroscopic g : kIntegrators) {
       std::map<int, LiftResult> results;
       for (int rate : rates) {
-        Row row = make_row("two_finger_lift", rate, g);
+        Row row = make_row("two_finger_lift", rate, g, scenario.model().integrator);
         time_it(row, opt.repeats, scenario.duration(), [&] { run_lift(scenario, rate, g, results[rate]); });
         rows.push_back(row);
       }
@@ -295,6 +233,8 @@ int main(int argc, char** argv) {
       }
     }
   }
+
+  std::vector<AccuracyFigures> accuracy = run_contact_accuracy(opt.cases, rates, opt.repeats, rows);
 
   // Stability boundary of the corner drop: the largest stable floor stiffness per rate.
   struct Boundary {
@@ -322,15 +262,22 @@ int main(int argc, char** argv) {
     std::cerr << "graspsim_bench: cannot write " << csv_path << "\n";
     return 2;
   }
+  // A cell never holds a comma (a refusal's message may): it would split the row.
+  const auto cell = [](std::string text) {
+    std::replace(text.begin(), text.end(), ',', ';');
+    return text;
+  };
+  // integrator: the gyroscopic option; scheme: Model::integrator.
   csv << "case,rate_hz,integrator,status,wall_per_sim_s,wall_min,wall_max,cpu_per_sim_s,repeats,error,error_measure,"
-         "energy_drift,momentum_drift,period_s,period_ref_s,precession_rad_s,precession_ref_rad_s,note\n";
-  std::printf("%-16s %6s %-9s %-28s %11s %11s %11s  %s\n", "case", "Hz", "gyro", "status", "wall/sim s",
+         "energy_drift,momentum_drift,period_s,period_ref_s,precession_rad_s,precession_ref_rad_s,note,scheme\n";
+  std::printf("%-16s %6s %-9s %-9s %-28s %11s %11s %11s  %s\n", "case", "Hz", "scheme", "gyro", "status", "wall/sim s",
               "cpu/sim s", "error", "details");
   for (const Row& r : rows) {
-    csv << r.name << ',' << r.rate << ',' << integrator_name(r.g) << ',' << r.status << ',' << num(r.cost) << ','
+    csv << r.name << ',' << r.rate << ',' << integrator_name(r.g) << ',' << cell(r.status) << ',' << num(r.cost) << ','
         << num(r.cost_min) << ',' << num(r.cost_max) << ',' << num(r.cpu) << ',' << r.repeats << ',' << num(r.error) << ','
-        << r.measure << ',' << num(r.energy_drift) << ',' << num(r.momentum_drift) << ',' << num(r.period) << ','
-        << num(r.period_ref) << ',' << num(r.precession) << ',' << num(r.precession_ref) << ',' << r.note << '\n';
+        << cell(r.measure) << ',' << num(r.energy_drift) << ',' << num(r.momentum_drift) << ',' << num(r.period) << ','
+        << num(r.period_ref) << ',' << num(r.precession) << ',' << num(r.precession_ref) << ',' << cell(r.note) << ','
+        << r.scheme << '\n';
     std::string details;
     if (!std::isnan(r.period_ref))
       details = "E " + num(r.energy_drift) + ", L " + num(r.momentum_drift) + ", period " +
@@ -338,10 +285,12 @@ int main(int argc, char** argv) {
     if (!std::isnan(r.precession_ref))
       details = "precession " + num(r.precession) + " rad/s (" + num(r.precession_ref) + ")";
     if (!r.note.empty()) details += (details.empty() ? "" : "; ") + r.note;
-    std::printf("%-16s %6d %-9s %-28s %11.3e %11.3e %11.3e  %s\n", r.name.c_str(), r.rate, integrator_name(r.g),
+    std::printf("%-16s %6d %-9s %-9s %-28s %11.3e %11.3e %11.3e  %s\n", r.name.c_str(), r.rate, r.scheme.c_str(),
+                integrator_name(r.g),
                 r.status.c_str(), r.cost, r.cpu, r.error, details.c_str());
   }
   for (const std::string& n : notes) std::printf("  %s\n", n.c_str());
+  print_contact_accuracy(accuracy);
 
   std::ofstream stab(stab_path);
   stab << "rate_hz,integrator,k_max_n_per_m,estimate_n_per_m\n";

@@ -233,7 +233,6 @@ PrecessionResult run_precession(int rate, Gyroscopic g, const PrecessionSetup& s
 
 // ---- c) corner_drop ------------------------------------------------------------------------
 
-namespace {
 Quat corner_down(double tip) {
   // Body diagonal vertical: 45 degrees about x, then atan(1/sqrt 2) about y; then tipped about
   // (1, 2, 0) so that it does not balance on the corner (as scenarios/corner_drop.lua).
@@ -241,7 +240,7 @@ Quat corner_down(double tip) {
          Quat(Eigen::AngleAxisd(std::atan(1.0 / std::sqrt(2.0)), Vec3::UnitY())) *
          Quat(Eigen::AngleAxisd(kPi / 4.0, Vec3::UnitX()));
 }
-double lowest_corner(const Mat3& R, double half) {   // m: min z of the corners about the centre
+double lowest_corner(const Mat3& R, double half) {
   double z = INFINITY;
   for (int i = 0; i < 8; ++i) {
     const Vec3 v(i & 1 ? half : -half, i & 2 ? half : -half, i & 4 ? half : -half);
@@ -249,7 +248,6 @@ double lowest_corner(const Mat3& R, double half) {   // m: min z of the corners 
   }
   return z;
 }
-}  // namespace
 
 Model corner_drop_model(int rate, Gyroscopic g, double stiffness, const CornerDropSetup& s) {
   Model m = free_model(rate, g);

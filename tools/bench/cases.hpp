@@ -86,6 +86,12 @@ struct CornerDropSetup {
   double mu = 0.6;          // 1
   double duration = 5.0;    // s: long enough for slow rocking instabilities (2 s missed some)
 };
+// A cube's orientation with its body diagonal vertical, then tipped `tip` rad about (1, 2, 0) so
+// that it does not balance on the corner (scenarios/corner_drop.lua, cube_settle.lua).
+Quat corner_down(double tip);
+// m: the lowest z of a cube's corners (half edge `half`) about its centre, turned by `rotation`.
+double lowest_corner(const Mat3& rotation, double half);
+
 Model corner_drop_model(int physics_rate, Gyroscopic g, double stiffness,
                         const CornerDropSetup& setup = {});
 

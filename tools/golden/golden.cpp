@@ -226,7 +226,10 @@ std::string bless_command(const std::string& scenario_file) {
 }
 
 app::RunResult run_for_golden(const std::string& scenario_file, const std::string& trace) {
-  const auto scenario = scripting::Scenario::load(scenario_file, scripting::LoadOptions{});
+  // Goldens hold the paper's scheme: they prove it stays bit for bit (README, "Golden traces").
+  scripting::LoadOptions load;
+  load.sets = {"integrator=paper"};
+  const auto scenario = scripting::Scenario::load(scenario_file, load);
   app::RunOptions options;
   options.out = trace;
   return app::run_scenario(scenario, options);

@@ -7,6 +7,7 @@
 #include <memory>
 #include <vector>
 
+#include "graspsim/engine/implicit_step.hpp"
 #include "graspsim/engine/manifold.hpp"
 #include "graspsim/engine/math.hpp"
 #include "graspsim/engine/model.hpp"
@@ -45,6 +46,14 @@ Vec3 floor_point(const Shape& shape, const Mat3& rotation, int k, bool& rolling)
 // Returns the number of points in contact.
 int floor_contact(const Model& model, int body, BodyState& bs, Wrench& out);
 
+// The floor points of body b for the implicit step, appended to `out` as couplings (world side
+// a = -1): the same law and anchors as floor_contact, but unclamped (the step's active set
+// clamps), and a point also counts while it is above the floor by less than it can close in one
+// step of length h, h (max(0, -u_n) + h |g|), so that a body arriving on the floor, or placed on
+// it with no load yet, is stopped by the step that would carry it in. Updates the points' anchors
+// as floor_contact does. Returns how many were appended.
+int floor_couplings(const Model& model, int body, BodyState& bs, double h, std::vector<Coupling>& out);
+
 // Body-body contact. Keeps its own FCL objects of the bodies (a dynamic AABB tree) for the
 // broadphase. Pairs of polyhedra (box, convex) get a clipped manifold (manifold.hpp); every other
 // pair (sphere, capsule, cylinder, mesh) gets FCL's contacts (collide with contacts; for meshes
@@ -65,11 +74,17 @@ class BodyContacts {
   // pairs' friction anchors in `state.pairs`. Allocation-free for pairs of polyhedra.
   void step(const Model& model, State& state, std::vector<Wrench>& wrenches, std::vector<int>& points);
 
+  // The same contact points and anchors for the implicit step: each point appended to `out` as a
+  // coupling (a < b, the normal from a towards b, the law unclamped), nothing summed.
+  void couplings(const Model& model, State& state, std::vector<Coupling>& out, std::vector<int>& points);
+
   // The contact points of bodies a < b at `state` (no friction update), into `out` (capacity
   // kMaxPairPoints). For tests and energy accounting.
   int points(const Model& model, const State& state, int a, int b, ManifoldPoint* out);
 
  private:
+  void run(const Model& model, State& state, std::vector<Wrench>* wrenches, std::vector<int>& points,
+           std::vector<Coupling>* out);
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };

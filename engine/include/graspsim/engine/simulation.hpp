@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "graspsim/engine/collision.hpp"
+#include "graspsim/engine/implicit_step.hpp"
 #include "graspsim/engine/model.hpp"
 #include "graspsim/engine/object_contact.hpp"
 #include "graspsim/engine/record.hpp"
@@ -23,11 +24,17 @@ class Simulation {
   //   3 servo    force on every finger, k (GO - HIP) with the newest HIP; its reaction, acting at
   //              the contact point on the surface (GO less the pad radius), is added to the
   //              contacted body's physics window
-  //   4 physics  (tick % (servo/physics) == 0): body-body contact wrenches for every pair in
-  //              contact, all at the state of this tick; then for every body, in body order: record
-  //              the state at this tick; residual F = finger impulse over the window / dt + floor +
-  //              other bodies + m g and T likewise; integrate over dt = 1/physics s;
-  //              clear the window; flag a body whose state diverged (see record.hpp)
+  //   4 physics  (tick % (servo/physics) == 0), over dt = 1/physics s, by Model::integrator:
+  //              paper     body-body contact wrenches for every pair in contact, all at the state
+  //                        of this tick; then for every body, in body order: record the state at
+  //                        this tick; residual F = finger impulse over the window / dt + floor +
+  //                        other bodies + m g and T likewise; grasp rules, dead band; integrate
+  //              implicit  every contact point (fingers, floor, body pairs) as a spring-damper
+  //                        about this tick's state; each island of touching bodies solved at once
+  //                        for its velocities at the end of the step; then for every body, in
+  //                        body order: record; the solved change as F and T; grasp rules, dead
+  //                        band; move (backward Euler, exact turn)
+  //              then per body: clear the window; flag a body whose state diverged (record.hpp)
   //   5 tick += 1
   // Time is tick / servo, computed, never accumulated.
   void step(const Input& input, TickRecord& record);
@@ -39,6 +46,25 @@ class Simulation {
   double time() const { return static_cast<double>(state_.tick) / model_.rates.servo; }   // s
 
  private:
+  // The stages of step(), in order.
+  void haptic_stage(const Input& input, TickRecord& record);
+  void servo_stage(const Input& input, TickRecord& record);
+  void physics_stage(const Input& input, TickRecord& record);
+  // The physics stage's parts.
+  double gimbal_pitch_change(const Input& input);
+  void wake_touched_bodies();
+  void paper_contacts();
+  void paper_body_step(int b, double pitch_change, TickRecord& record);
+  void implicit_contacts(const Input& input);
+  void implicit_solve();
+  void implicit_body_step(int b, double pitch_change, TickRecord& record);
+  void record_sleeping(int b, TickRecord& record);
+  BodyRecord& record_state(int b, int floor_contacts, TickRecord& record);
+  void apply_grasp_rules(int b, double pitch_change, const Wrench& contact, BodyState& bs, Vec3& torque,
+                         BodyRecord& rec);
+  void mark_stepped(BodyState& bs) const;
+  void finish_body_step(int b, TickRecord& record);
+
   Model model_;
   Divisors divisors_;
   State state_;
@@ -46,10 +72,22 @@ class Simulation {
   bool collision_stale_ = false;   // bodies moved since collision_ was last updated
   std::vector<int> scratch_;   // candidate bodies of a finger query
   BodyContacts body_contacts_;            // body-body contact (its own broadphase)
-  std::vector<Wrench> contact_wrench_;    // per body: body-body contact wrench of this step
+  std::vector<Wrench> contact_wrench_;    // per body: floor and body-body contact wrench of this step
+                                          //   (paper: body-body only; the floor's is added per body)
   std::vector<int> contact_points_;       // per body: body-body contact points of this step
   std::vector<double> floor_reach_;       // m, per body: farthest floor point from the centre of mass
   std::vector<std::uint8_t> floor_clear_;  // per body: 1 when none of its floor points is active
+  // The implicit step's buffers (sized once).
+  ImplicitStep implicit_;
+  std::vector<Coupling> couplings_;       // this step's contact points
+  std::vector<std::uint8_t> awake_;       // per body: 1 when stepped
+  std::vector<Vec3> v0_, w0_;             // m/s, rad/s, per body: velocities at the start of the step
+                                          //   (w0 after the gyroscopic change)
+  std::vector<Vec3> external_force_;      // N, per body: fingers' window mean and gravity
+  std::vector<Vec3> external_torque_;     // N m, per body: fingers' window mean
+  std::vector<int> floor_points_;         // per body: floor points pushing at the end of the step
+  std::vector<Vec3> finger_point_;        // m, world, per finger: contact point of this servo tick
+  std::vector<Vec3> finger_force_;        // N, world, per finger: force on the finger this servo tick
 };
 
 }  // namespace graspsim

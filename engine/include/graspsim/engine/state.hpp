@@ -40,6 +40,10 @@ struct FingerState {
                                             //    tick (static or kinetic, as the phase was)
   double pitch_at_last_physics = 0.0;       // rad: gimbal pitch at the previous physics step
   bool has_pitch = false;                   // false until the first physics step
+  Vec3 hip_at_last_physics{0.0, 0.0, 0.0};  // m, world: HIP at the previous physics step (implicit
+                                            //    integrator: the HIP's velocity over the window)
+  bool has_last_physics = false;            // false until the first physics step (always, under
+                                            //    the paper's integrator, which does not use it)
 };
 
 // One floor point of a body (a vertex, or the lowest point of a sphere) against the floor: its

@@ -1,0 +1,105 @@
+// The linearly implicit physics step: every body, and every group of bodies that touch, moved at
+// once over all of its spring-damper couplings (fingers, floor points, other bodies), so that no
+// stiffness, damping or physics rate can make the step gain energy (engine/README.md,
+// "Integrators").
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "graspsim/engine/math.hpp"
+#include "graspsim/engine/model.hpp"
+#include "graspsim/engine/state.hpp"
+
+namespace graspsim {
+
+// One contact point as the implicit step sees it: the force it exerts at the start of the step
+// and how that force changes as the two bodies move during the step, a spring-damper about the
+// present state. With u the velocity of b's material at the point relative to a's (or to the
+// world side's velocity), and over the step the point's relative displacement taken as h u1
+// (backward Euler):
+//   f(u1) = force + C u0 - (h K + C) u1,   K = k_n n n^T + k_t (I - n n^T), C likewise.
+// Floor and body points are unilateral with Coulomb friction: after the solve a point whose
+// normal force would pull is dropped, and one whose tangential force leaves the cone slips, its
+// tangential spring and damper replaced by a sliding force mu f_n (+ viscous) (an active set,
+// ImplicitStep::solve); its sliding force follows its normal force within the solve.
+// Fingers are already held in their cone by the servo stage (mu < 0).
+struct Coupling {
+  enum class Source : std::uint8_t { kFinger, kFloor, kBody };
+  Source source = Source::kFinger;
+  int slot = -1;                   // the source's index: finger, floor point, or point of the pair
+  int a = -1;                      // body pushed by -f, or -1 for the world (floor, a finger's HIP)
+  int b = -1;                      // body pushed by +f
+  Vec3 point{0.0, 0.0, 0.0};       // m, world: where the force acts
+  Vec3 normal{0.0, 0.0, 1.0};      // 1, world, unit: the direction in which the normal force pushes b
+  Vec3 world_velocity{0.0, 0.0, 0.0};   // m/s, world: the world side's velocity over the step when
+                                        //    a = -1 (a finger's HIP, taken to go on as over the last
+                                        //    window; 0 for the floor)
+  Vec3 force{0.0, 0.0, 0.0};       // N, world, on b: at the start of the step (floor and body
+                                   //    points: the penalty law unclamped, so that it extends linearly)
+  double k_n = 0.0, c_n = 0.0;     // N/m, N s/m: along the normal
+  double k_t = 0.0, c_t = 0.0;     // N/m, N s/m: across it
+  double mu = -1.0;                // 1: friction limit |f_t| <= mu f_n + viscous; < 0 for none
+  double viscous = 0.0;            // N: viscous sliding force c |u_t| at the start (while slipping)
+};
+
+// What the solve decided for a coupling.
+enum class CouplingMode : std::uint8_t {
+  kHold,    // the whole spring-damper acts (sticking)
+  kSlip,    // normal spring-damper and a sliding force on the friction cone
+  kOff,     // the point separates: no force
+};
+
+// The solver's buffers, sized once for the model so that the step allocates nothing.
+class ImplicitStep {
+ public:
+  explicit ImplicitStep(const Model& model);
+
+  // Solves (M + h C + h^2 K) q1 = M q0 + h (Q + sum J^T (force + C u0)) for the bodies'
+  // velocities q1 = (v1, w1) at the end of the step, island by island, with the active set of
+  // the couplings' unilateral and friction limits. `q0` holds each body's (v, w) at the start
+  // (after the gyroscopic change), `wrench` the external force and torque on each body over the
+  // step (gravity, fingers' window), `awake` which bodies move. Results: velocities(), mode(i)
+  // and force(i) for every coupling, solved at the end of the step.
+  void solve(const Model& model, const State& state, const std::vector<Coupling>& couplings,
+             const std::vector<std::uint8_t>& awake, const std::vector<Vec3>& v0,
+             const std::vector<Vec3>& w0, const std::vector<Vec3>& force,
+             const std::vector<Vec3>& torque, double h);
+
+  const Vec3& velocity(int body) const { return v1_[body]; }            // m/s, world
+  const Vec3& angular_velocity(int body) const { return w1_[body]; }    // rad/s, world
+  CouplingMode mode(std::size_t coupling) const { return mode_[coupling]; }
+  // N, world, on b: the coupling's force at the end of the step (zero when kOff).
+  const Vec3& force(std::size_t coupling) const { return solved_[coupling]; }
+
+  // Most active-set rounds per island: each round changes at least one point's mode, hold ->
+  // slip -> off, never back, so the set settles; the cap bounds the cost of a rare long cascade.
+  static constexpr int kMaxRounds = 8;
+
+ private:
+  int find(int body);
+  void assemble_and_solve(const Model& model, const State& state, const std::vector<Coupling>& couplings,
+                          const std::vector<Vec3>& v0, const std::vector<Vec3>& w0,
+                          const std::vector<Vec3>& force, const std::vector<Vec3>& torque, double h);
+  Vec3 relative_velocity(const State& state, const Coupling& c, const std::vector<Vec3>& v,
+                         const std::vector<Vec3>& w) const;
+
+  std::vector<int> parent_;                 // union-find over bodies joined by body points
+  std::vector<int> island_of_;              // body -> island index, or -1 (asleep)
+  std::vector<int> local_;                  // body -> index inside its island
+  std::vector<int> island_bodies_;          // bodies grouped by island
+  std::vector<int> island_start_;           // island i: island_bodies_[start[i], start[i+1])
+  std::vector<int> island_couplings_;       // couplings grouped by island
+  std::vector<int> coupling_start_;         // likewise for couplings
+  std::vector<double> matrix_;              // (6 n)^2, row-major: the island's system, then its factor
+  std::vector<double> rhs_;                 // 6 n: right side, then the solution
+  std::vector<Vec3> v1_, w1_;               // per body: the solved velocities
+  std::vector<CouplingMode> mode_;          // per coupling
+  std::vector<Vec3> slide_;                 // 1, world, per coupling: unit direction of the sliding
+                                            //    force while kSlip
+  std::vector<Vec3> solved_;                // N, world, per coupling: force at the end of the step
+  std::vector<int> current_;                // the island being solved: its bodies, couplings
+  std::vector<int> current_couplings_;
+};
+
+}  // namespace graspsim

@@ -1,0 +1,243 @@
+// The linearly implicit step (backward Euler on each island's velocities, linearised couplings)
+// and its active set of unilateral, frictional points.
+#include "graspsim/engine/implicit_step.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace graspsim {
+namespace {
+
+// Solves A x = b in place by Gaussian elimination with partial pivoting (`a` row-major n x n,
+// overwritten; `b` becomes x). The island's matrix M + h (h K + C) is positive definite but for
+// sliding points, whose friction force follows their normal force, mu t n^T, which makes it
+// unsymmetric; pivoting keeps the elimination backward stable either way. A zero or non-finite
+// pivot leaves `b` non-finite, which the step's divergence check sees.
+void lu_solve(double* a, double* b, int n) {
+  for (int j = 0; j < n; ++j) {
+    int p = j;
+    for (int i = j + 1; i < n; ++i) {
+      if (std::abs(a[i * n + j]) > std::abs(a[p * n + j])) p = i;
+    }
+    if (p != j) {
+      for (int k = j; k < n; ++k) std::swap(a[j * n + k], a[p * n + k]);
+      std::swap(b[j], b[p]);
+    }
+    const double pivot = a[j * n + j];
+    for (int i = j + 1; i < n; ++i) {
+      const double l = a[i * n + j] / pivot;
+      if (l == 0.0) continue;
+      for (int k = j + 1; k < n; ++k) a[i * n + k] -= l * a[j * n + k];
+      b[i] -= l * b[j];
+    }
+  }
+  for (int i = n - 1; i >= 0; --i) {
+    double s = b[i];
+    for (int k = i + 1; k < n; ++k) s -= a[i * n + k] * b[k];
+    b[i] = s / a[i * n + i];
+  }
+}
+
+// G = h K + C of a coupling in its mode (3x3, world): the force's change per unit of relative
+// velocity at the end of the step. While sliding along unit t (tangential, the way the held
+// spring pulled) the tangential force is mu times the normal one: G = g_n (n + mu t) n^T.
+Mat3 response(const Coupling& c, CouplingMode mode, const Vec3& slide, double h) {
+  const double g_n = h * c.k_n + c.c_n;
+  if (mode == CouplingMode::kSlip) return g_n * (c.normal + c.mu * slide) * c.normal.transpose();
+  const Mat3 nn = c.normal * c.normal.transpose();
+  const double g_t = h * c.k_t + c.c_t;
+  return g_n * nn + g_t * (Mat3::Identity() - nn);
+}
+
+// The constant part of the force, force + C u0, in its mode; while sliding along t the
+// tangential part is mu times the normal part, plus the viscous force.
+Vec3 constant_force(const Coupling& c, CouplingMode mode, const Vec3& u0, const Vec3& slide) {
+  const Vec3& n = c.normal;
+  const double normal = n.dot(c.force) + c.c_n * n.dot(u0);   // N
+  if (mode == CouplingMode::kSlip) return normal * (n + c.mu * slide) + c.viscous * slide;
+  const Vec3 tangential = c.force - n.dot(c.force) * n + c.c_t * (u0 - n.dot(u0) * n);
+  return normal * n + tangential;
+}
+
+// Adds s * J_x^T G J_y into the 6x6 block at (row, col) of the n-wide matrix, J = [I, -S(r)]:
+//   J_x^T G J_y = [[G, -G S_y], [S_x G, -S_x G S_y]].
+void add_block(double* m, int n, int row, int col, const Mat3& g, const Vec3& r_x, const Vec3& r_y, double s) {
+  const Mat3 sx = skew(r_x), sy = skew(r_y);
+  const Mat3 gs = g * sy;
+  const Mat3 blocks[2][2] = {{g, -gs}, {sx * g, -(sx * gs)}};
+  for (int bi = 0; bi < 2; ++bi)
+    for (int bj = 0; bj < 2; ++bj)
+      for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) m[(row + 3 * bi + i) * n + col + 3 * bj + j] += s * blocks[bi][bj](i, j);
+}
+
+}  // namespace
+
+ImplicitStep::ImplicitStep(const Model& model) {
+  const std::size_t n = model.bodies.size();
+  parent_.resize(n);
+  island_of_.resize(n);
+  local_.resize(n);
+  current_.reserve(n);
+  matrix_.resize(36 * n * n);
+  rhs_.resize(6 * n);
+  v1_.resize(n);
+  w1_.resize(n);
+}
+
+int ImplicitStep::find(int body) {
+  while (parent_[body] != body) body = parent_[body] = parent_[parent_[body]];
+  return body;
+}
+
+Vec3 ImplicitStep::relative_velocity(const State& state, const Coupling& c, const std::vector<Vec3>& v,
+                                     const std::vector<Vec3>& w) const {
+  const auto point_velocity = [&](int body) -> Vec3 {
+    if (body < 0 || island_of_[body] < 0) return Vec3::Zero();
+    return v[body] + w[body].cross(c.point - state.bodies[body].position);
+  };
+  return point_velocity(c.b) - (c.a < 0 ? c.world_velocity : point_velocity(c.a));
+}
+
+void ImplicitStep::solve(const Model& model, const State& state, const std::vector<Coupling>& couplings,
+                         const std::vector<std::uint8_t>& awake, const std::vector<Vec3>& v0,
+                         const std::vector<Vec3>& w0, const std::vector<Vec3>& force,
+                         const std::vector<Vec3>& torque, double h) {
+  const int nb = static_cast<int>(model.bodies.size());
+  mode_.assign(couplings.size(), CouplingMode::kHold);
+  slide_.assign(couplings.size(), Vec3::Zero());
+  solved_.assign(couplings.size(), Vec3::Zero());
+  for (int b = 0; b < nb; ++b) {
+    parent_[b] = b;
+    island_of_[b] = awake[b] ? 0 : -1;
+    v1_[b] = v0[b];
+    w1_[b] = w0[b];
+  }
+  // Islands: awake bodies joined by a body point (a sleeping body stays put, as the world does).
+  for (const Coupling& c : couplings) {
+    if (c.a >= 0 && c.b >= 0 && awake[c.a] && awake[c.b]) {
+      const int ra = find(c.a), rb = find(c.b);
+      if (ra != rb) parent_[std::max(ra, rb)] = std::min(ra, rb);
+    }
+  }
+  for (int root = 0; root < nb; ++root) {
+    if (!awake[root] || find(root) != root) continue;
+    current_.clear();
+    for (int b = root; b < nb; ++b) {
+      if (awake[b] && find(b) == root) {
+        local_[b] = static_cast<int>(current_.size());
+        current_.push_back(b);
+      }
+    }
+    current_couplings_.clear();
+    for (std::size_t i = 0; i < couplings.size(); ++i) {
+      const Coupling& c = couplings[i];
+      const int body = (c.b >= 0 && awake[c.b]) ? c.b : c.a;
+      if (body >= 0 && awake[body] && find(body) == root) current_couplings_.push_back(static_cast<int>(i));
+    }
+    // Rounds: solve, then change modes where the solution breaks a limit. A point leaving the
+    // cone is decided before any point letting go: a held point stops the body dead, and the
+    // torque that takes can lift other points that a sliding body keeps on the floor.
+    for (int round = 0; round < kMaxRounds; ++round) {
+      assemble_and_solve(model, state, couplings, v0, w0, force, torque, h);
+      bool slipped = false, released = false;
+      for (int i : current_couplings_) {
+        const Coupling& c = couplings[i];
+        const Vec3 u0 = relative_velocity(state, c, v0, w0);
+        const Vec3 u1 = relative_velocity(state, c, v1_, w1_);
+        solved_[i] = constant_force(c, mode_[i], u0, slide_[i]) - response(c, mode_[i], slide_[i], h) * u1;
+        if (c.mu < 0.0 || mode_[i] != CouplingMode::kHold) continue;
+        const double f_n = c.normal.dot(solved_[i]);
+        const Vec3 f_t = solved_[i] - f_n * c.normal;
+        const double f_t_norm = f_t.norm();
+        // Out of the cone (or pulling, which no cone holds): it slides the way it pulled. A
+        // pulling point slides before it may let go, so that a held point's drag, which pitches
+        // the body, is gone before the solve decides which points lift off.
+        if (f_t_norm > c.mu * std::max(0.0, f_n) + c.viscous) {
+          mode_[i] = CouplingMode::kSlip;
+          slide_[i] = f_t / f_t_norm;
+          slipped = true;
+        }
+      }
+      if (!slipped) {
+        for (int i : current_couplings_) {
+          const Coupling& c = couplings[i];
+          if (c.mu < 0.0 || mode_[i] == CouplingMode::kOff || c.normal.dot(solved_[i]) >= 0.0) continue;
+          mode_[i] = CouplingMode::kOff;   // it would pull: the point lets go
+          released = true;
+        }
+      }
+      if (!slipped && !released) break;
+    }
+    for (int i : current_couplings_) {
+      if (mode_[i] == CouplingMode::kOff) solved_[i].setZero();
+    }
+  }
+}
+
+void ImplicitStep::assemble_and_solve(const Model& model, const State& state,
+                                      const std::vector<Coupling>& couplings, const std::vector<Vec3>& v0,
+                                      const std::vector<Vec3>& w0, const std::vector<Vec3>& force,
+                                      const std::vector<Vec3>& torque, double h) {
+  const int n = 6 * static_cast<int>(current_.size());
+  double* m = matrix_.data();
+  double* r = rhs_.data();
+  std::fill(m, m + n * n, 0.0);
+  // M q0 + h Q: each body's mass and world inertia R Jp R^T, its momentum and the external wrench.
+  for (int b : current_) {
+    const int o = 6 * local_[b];
+    const BodyParams& bp = model.bodies[b];
+    const Mat3& R = state.bodies[b].rotation;
+    const Mat3 inertia = R * bp.inertia.asDiagonal() * R.transpose();   // kg m^2, world
+    const Vec3 p = bp.mass * v0[b] + h * force[b];
+    const Vec3 l = inertia * w0[b] + h * torque[b];
+    for (int i = 0; i < 3; ++i) {
+      m[(o + i) * n + o + i] = bp.mass;
+      for (int j = 0; j < 3; ++j) m[(o + 3 + i) * n + o + 3 + j] = inertia(i, j);
+      r[o + i] = p[i];
+      r[o + 3 + i] = l[i];
+    }
+  }
+  // Each coupling: h J^T G J into the matrix, h J^T (force + C u0) into the right side.
+  for (int i : current_couplings_) {
+    const Coupling& c = couplings[i];
+    if (mode_[i] == CouplingMode::kOff) continue;
+    const Mat3 g = response(c, mode_[i], slide_[i], h);
+    Vec3 fc = constant_force(c, mode_[i], relative_velocity(state, c, v0, w0), slide_[i]);
+    if (c.a < 0) fc += g * c.world_velocity;   // the world side moves on: u1 = J q1 - v_world
+    const bool in_b = c.b >= 0 && island_of_[c.b] >= 0;
+    const bool in_a = c.a >= 0 && island_of_[c.a] >= 0;
+    const Vec3 r_b = in_b ? Vec3(c.point - state.bodies[c.b].position) : Vec3::Zero();
+    const Vec3 r_a = in_a ? Vec3(c.point - state.bodies[c.a].position) : Vec3::Zero();
+    if (in_b) {
+      const int o = 6 * local_[c.b];
+      add_block(m, n, o, o, g, r_b, r_b, h);
+      const Vec3 t = r_b.cross(fc);
+      for (int k = 0; k < 3; ++k) {
+        r[o + k] += h * fc[k];
+        r[o + 3 + k] += h * t[k];
+      }
+    }
+    if (in_a) {
+      const int o = 6 * local_[c.a];
+      add_block(m, n, o, o, g, r_a, r_a, h);
+      const Vec3 t = r_a.cross(fc);
+      for (int k = 0; k < 3; ++k) {
+        r[o + k] -= h * fc[k];
+        r[o + 3 + k] -= h * t[k];
+      }
+    }
+    if (in_a && in_b) {
+      add_block(m, n, 6 * local_[c.b], 6 * local_[c.a], g, r_b, r_a, -h);
+      add_block(m, n, 6 * local_[c.a], 6 * local_[c.b], g, r_a, r_b, -h);
+    }
+  }
+  lu_solve(m, r, n);
+  for (int b : current_) {
+    const int o = 6 * local_[b];
+    v1_[b] = Vec3(r[o], r[o + 1], r[o + 2]);
+    w1_[b] = Vec3(r[o + 3], r[o + 4], r[o + 5]);
+  }
+}
+
+}  // namespace graspsim
