@@ -140,6 +140,7 @@ Scenario Scenario::load_source(const std::string& source, const std::string& pat
     s.model_ = std::move(parts.model);
     s.duration_ = parts.duration;
     s.seed_ = parts.seed;
+    s.refuse_unstable_ = parts.refuse_unstable;
     s.fingers_ = std::move(parts.fingers);
     s.expectations_ = std::move(parts.expectations);
     for (detail::TrajectoryParts& t : parts.trajectories) {

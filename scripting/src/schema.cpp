@@ -491,8 +491,8 @@ bool is_named_array(TableKind kind) {
 
 const std::vector<std::string>& fields_of(TableKind kind) {
   static const std::vector<std::string> kRoot = {
-      "name", "description", "duration", "seed", "rates", "gravity", "integrator", "gyroscopic",
-      "grasp", "floor", "sleep", "objects", "fingers", "expect"};
+      "name", "description", "duration", "seed", "rates", "gravity", "integrator", "stability",
+      "gyroscopic", "grasp", "floor", "sleep", "objects", "fingers", "expect"};
   static const std::vector<std::string> kGrasp = {"torsion", "critical_area", "gimbal_finger", "dead_band",
                                                       "torsional_damping"};
   static const std::vector<std::string> kRates = {"servo", "haptic", "physics"};
@@ -619,6 +619,9 @@ ScenarioParts convert_scenario(const LuaValue& root, const std::string& default_
   if (const LuaValue* i = r.get("integrator")) {
     const std::string name = choice(*i, r.at("integrator"), {"paper", "implicit"}, "integrator");
     s.model.integrator = name == "paper" ? Integrator::kPaper : Integrator::kImplicit;
+  }
+  if (const LuaValue* st = r.get("stability")) {
+    s.refuse_unstable = choice(*st, r.at("stability"), {"warn", "refuse"}, "stability choice") == "refuse";
   }
   if (const LuaValue* g = r.get("gyroscopic")) {
     const std::string name = choice(*g, r.at("gyroscopic"), {"neglect", "explicit", "implicit"}, "gyroscopic");

@@ -50,6 +50,7 @@ struct ScenarioParts {
   Model model;
   double duration = 0.0;      // s
   std::uint64_t seed = 0;
+  bool refuse_unstable = false;   // stability = "refuse"
   std::vector<FingerSetup> fingers;
   std::vector<TrajectoryParts> trajectories;   // one per finger
   std::vector<Expectation> expectations;

@@ -159,6 +159,23 @@ TEST_CASE("gyroscopic, grasp and kinetic friction fields convert to the model", 
   CHECK(graspsim::kinetic_mu(m.bodies[1].material) == m.bodies[1].material.mu);   // unset: = mu
 }
 
+// stability: absent or "warn" only warns, "refuse" stops the run at an unstable mode; any other
+// value is an error naming the field and the choices.
+TEST_CASE("the stability field chooses between a warning and a refusal", "[scenario][load]") {
+  const auto refuses = [](std::vector<std::string> sets) {
+    graspsim::scripting::LoadOptions options;
+    options.sets = std::move(sets);
+    return graspsim::scripting::Scenario::load(scripting_test::data_path("valid.lua"), options).refuse_unstable();
+  };
+  CHECK_FALSE(refuses({}));
+  CHECK_FALSE(refuses({"stability=warn"}));
+  CHECK(refuses({"stability=refuse"}));
+  graspsim::scripting::LoadOptions options;
+  options.sets = {"stability=stop"};
+  CHECK_THAT(scripting_test::load_error(scripting_test::data_path("valid.lua"), options),
+             Catch::Contains("stability") && Catch::Contains("refuse"));
+}
+
 // sleep: absent is off; true takes the defaults; a table (here made by --set of its fields) turns
 // it on with its fields.
 TEST_CASE("the sleep field converts to the model", "[scenario][load]") {

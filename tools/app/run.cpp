@@ -14,6 +14,7 @@
 #include <thread>
 
 #include "app/script_thread.hpp"
+#include "app/stability_watch.hpp"
 
 #include "graspsim/engine/simulation.hpp"
 #include "graspsim/engine/state_hash.hpp"
@@ -251,10 +252,11 @@ RunResult run_scenario(const scripting::Scenario& scenario, const RunOptions& op
       }
     }
   };
-  result.warnings = stability_warnings(model);
-  std::string warnings;
-  for (const std::string& w : result.warnings) warnings += w + "\n";
-  writer.set_attribute("warnings", warnings);
+  // Written now and again at close with the run's own, so a trace cut by a crash still has the
+  // model's.
+  StabilityWatch stability(model, options.refuse_unstable || scenario.refuse_unstable(), options.on_warning);
+  stability.before_run();
+  writer.set_attribute("warnings", stability.text());
   writer.set_attribute("force_ramp", options.force_ramp);
 
   const auto start = Clock::now();
@@ -453,6 +455,7 @@ RunResult run_scenario(const scripting::Scenario& scenario, const RunOptions& op
                "masses at rates.physics = " << model.rates.physics << " Hz";
         throw std::runtime_error(msg.str());
       }
+      if (record.physics_ran) stability.after_physics(sim.state(), n, t);   // throws to refuse
       if (record.haptic_ran) {
         ++result.haptic_ticks;
         for (std::size_t f = 0; f < slip.size(); ++f) slip[f] += record.haptic[f].slip;
@@ -500,6 +503,7 @@ RunResult run_scenario(const scripting::Scenario& scenario, const RunOptions& op
     result.error = e.what();
   }
   if (sim_holder) result.simulated = sim_holder->time();
+  result.warnings = stability.lines();
   release_all();   // at the end, on error, on interrupt: no device keeps a force
   if (result.error.empty() && !release_error.empty()) result.error = release_error;
   if (realtime) leave_realtime();
@@ -535,6 +539,7 @@ RunResult run_scenario(const scripting::Scenario& scenario, const RunOptions& op
   }
   try {
     writer.set_attribute("expectations", summary.str());
+    writer.set_attribute("warnings", stability.text());
     if (writer_holder) writer_holder->close(result.error.empty() ? "complete" : "error: " + result.error);
   } catch (const std::exception& e) {
     if (result.error.empty()) result.error = std::string("writing the trace: ") + e.what();

@@ -62,6 +62,14 @@ struct RunOptions {
   // real device). Only what devices render changes, never the engine; root attribute
   // `force_ramp`, which a replay applies again.
   double force_ramp = 0.0;
+  // The stability check (engine/stability.hpp, tools/app/stability_watch.hpp): each warning line,
+  // before the run and as the run finds an unstable mode (with its simulated time), goes to
+  // `on_warning` (may be empty) and into the trace's `warnings`. `refuse_unstable` (or the
+  // scenario's stability = "refuse") stops the run at the first unstable mode, with an error
+  // naming it. The analysis runs on the loop's thread when the contact set changes (tens to
+  // hundreds of microseconds), so in a paced run such a tick may be late.
+  std::function<void(const std::string& warning)> on_warning;
+  bool refuse_unstable = false;
   // Tests only: in a paced run, the loop waits for a Lua trajectory sample the script thread can
   // still compute instead of holding the last one (ScriptThreadOptions::wait_for_samples), so a
   // paced run on a fake clock, which outruns any thread, gets every sample. Never with a hand on
@@ -80,7 +88,8 @@ class RecordedPacing {
 struct RunResult {
   std::string trace_path;
   std::vector<scripting::ExpectationResult> expectations;
-  std::vector<std::string> warnings;   // stability warnings about the model (see engine/model.hpp)
+  std::vector<std::string> warnings;   // stability warnings: the model's estimates before the run,
+                                       // then "t = T s (tick N): ..." for each mode found in it
   std::int64_t servo_ticks = 0, haptic_ticks = 0, physics_ticks = 0;
   double simulated = 0.0;   // s: how far the run got
   double wall = 0.0;        // s

@@ -34,7 +34,7 @@ using graspsim::cli::kExitOk;
 
 constexpr const char* kUsage =
     "usage: graspsim run SCENARIO.lua [--out FILE.h5] [--duration S] [--set NAME=VALUE]...\n"
-    "                [--device FINGER=SPEC]... [--jitter A [--jitter-seed N]]\n"
+    "                [--device FINGER=SPEC]... [--jitter A [--jitter-seed N]] [--refuse-unstable]\n"
     "       graspsim replay TRACE.h5 [--out NEW.h5] [--set NAME=VALUE]...\n"
     "       graspsim repair TRACE.h5\n"
     "       graspsim compare A.h5 B.h5 [--atol X] [--rtol X] [--tol PATTERN=ATOL[,RTOL]]...\n"
@@ -71,12 +71,21 @@ constexpr const char* kHelp =
     "  --jitter-seed N      the jitter's seed, an integer 0 to 2^63 - 1 (default 0): the same\n"
     "                       seed gives the same offsets on every machine\n"
     "  --compress N         deflate the trace at level N (1..9; default none)\n"
+    "  --refuse-unstable    stop the run at the first unstable mode the stability check\n"
+    "                       finds (as the scenario field stability = \"refuse\"), exit 2;\n"
+    "                       without it each one is a warning on stderr, with its time\n"
     "  --quiet              print only errors and failed expectations\n"
     "  -h, --help           this help\n"
     "  --version            the build's version\n"
     "\n"
+    "stability: before the run and whenever the contact set changes, the check analyses the\n"
+    "one-step map of every body and group of touching bodies on all its springs (fingers,\n"
+    "floor, other bodies) under the scheme in use, and warns of a mode that grows from one\n"
+    "physics step to the next, naming its motion, its springs and the rate that holds it.\n"
+    "\n"
     "exit status: 0 every expectation held, 1 an expectation failed, 2 bad input (arguments,\n"
-    "scenario, output path, or an error in the script while it ran), 130 interrupted.\n"
+    "scenario, output path, an error in the script while it ran, or a refused unstable\n"
+    "mode), 130 interrupted.\n"
     "A run that stops early keeps its trace, with root attribute status = \"error: ...\".\n"
     "A run killed outright leaves status \"running\" and every tick up to its last flush\n"
     "(at most 0.25 s simulated or 1 s wall old): h5py opens it with swmr=True; after\n"
@@ -178,7 +187,7 @@ int run_command(const std::vector<std::string>& args) {
   std::string scenario_path, out;
   graspsim::scripting::LoadOptions load;
   int compression = 0;
-  bool quiet = false;
+  bool quiet = false, refuse_unstable = false;
   std::vector<std::string> device_options;
   bool jitter_seed_given = false;
   for (std::size_t i = 0; i < args.size(); ++i) {
@@ -228,6 +237,8 @@ int run_command(const std::vector<std::string>& args) {
       compression = static_cast<int>(level);
     } else if (a == "--quiet") {
       quiet = true;
+    } else if (a == "--refuse-unstable") {
+      refuse_unstable = true;
     } else if (a.rfind("-", 0) == 0) {
       return bad_input("unknown option '" + a + "'\n" + kUsage);
     } else if (scenario_path.empty()) {
@@ -286,8 +297,12 @@ int run_command(const std::vector<std::string>& args) {
     };
   }
   std::signal(SIGINT, on_sigint);
-  for (const std::string& w : graspsim::stability_warnings(scenario->model()))
+  options.refuse_unstable = refuse_unstable;
+  // Each stability warning as it is found (the progress line, if any, is cleared first).
+  options.on_warning = [tty](const std::string& w) {
+    if (tty) std::fprintf(stderr, "\r%60s\r", "");
     std::cerr << "graspsim: warning: " << w << "\n";
+  };
 
   graspsim::app::RunResult result;
   try {

@@ -173,8 +173,10 @@ struct Divisors {
 // Checks the model and throws std::invalid_argument naming the offending field.
 void validate(const Model& model);
 
-// Warnings, one sentence each, for contacts stiff or damped enough to make the explicit
-// integration unstable at the model's physics rate (estimates; see model.cpp).
+// Warnings, one sentence each, for contacts stiff or damped enough to make the paper's explicit
+// integration unstable at the model's physics rate (estimates per kind of spring, before a run;
+// see model.cpp), and for pairs of bodies that cannot collide. The coupled modes of the contact
+// set a run reaches are stability.hpp's.
 std::vector<std::string> stability_warnings(const Model& model);
 Divisors divisors(const Rates& rates);
 

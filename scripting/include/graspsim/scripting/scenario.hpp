@@ -115,6 +115,9 @@ class Scenario {
   const Model& model() const { return model_; }
   double duration() const { return duration_; }              // s
   std::uint64_t seed() const { return seed_; }
+  // stability = "refuse": an unstable mode found by the stability check stops the run
+  // (engine/stability.hpp); "warn" (the default) only warns.
+  bool refuse_unstable() const { return refuse_unstable_; }
   const std::vector<FingerSetup>& fingers() const { return fingers_; }
   const std::vector<Expectation>& expectations() const { return expectations_; }
   // Every parameter after overrides, as sorted "path = value" lines, for the trace.
@@ -167,6 +170,7 @@ class Scenario {
   Model model_;
   double duration_ = 0.0;
   std::uint64_t seed_ = 0;
+  bool refuse_unstable_ = false;
   std::vector<FingerSetup> fingers_;
   std::vector<Expectation> expectations_;
   std::vector<std::string> parameters_;
