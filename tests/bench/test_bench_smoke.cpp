@@ -94,7 +94,7 @@ TEST_CASE("graspsim_bench --quick writes the work-precision CSV and the stabilit
 }
 
 // The robustness case on one scenario, two seeds: robustness.csv has, per integrator, one row per
-// expectation (the lift has 5) and per run check (3), each passed in at most `runs` runs, and the
+// expectation (the lift has 5) and per run check (4), each passed in at most `runs` runs, and the
 // worst body excursion, a finite positive length (the lift moves its box 5 cm at least).
 TEST_CASE("graspsim_bench --cases robustness writes pass rates per check and integrator", "[bench]") {
   const std::string dir = GRASPSIM_TEST_TMP "/bench-smoke-robustness";
@@ -115,7 +115,7 @@ TEST_CASE("graspsim_bench --cases robustness writes pass rates per check and int
     }
     rows.push_back(cells);
   }
-  REQUIRE(rows.size() == 1 + 2 * (5 + 3 + 1));
+  REQUIRE(rows.size() == 1 + 2 * (5 + 4 + 1));
   CHECK(rows[0] == std::vector<std::string>{"scenario", "integrator", "check", "passed", "runs", "value"});
   std::set<std::string> integrators;
   for (std::size_t i = 1; i < rows.size(); ++i) {

@@ -21,6 +21,7 @@ inline constexpr double kPi = 3.141592653589793;
 inline const std::string kRan = "the run reaches its end";
 inline const std::string kFinite = "no NaN or infinity anywhere in the trace";
 inline const std::string kInScene = "every body stays in its scene";
+inline const std::string kSmooth = "no body's motion reverses at every physics step";
 
 enum class Kind { kJitter, kSimPhantom };
 
@@ -48,7 +49,7 @@ inline std::string text(const char* format, double a, double b = 0.0, double c =
 struct Known {
   std::string scenario;
   Kind kind;
-  std::string check;    // part of the expectation's sentence, or kRan, kFinite, kInScene
+  std::string check;    // part of the expectation's sentence, or kRan, kFinite, kInScene, kSmooth
   std::string reason;
   std::function<std::string(const Run&)> explained;
 };

@@ -7,7 +7,9 @@
 //   - the run reaches its end (no divergence, no script error);
 //   - no recorded quantity of any loop is NaN or infinite (every column of the trace);
 //   - no body leaves its scene: its centre stays within 1 m of where it started and above the
-//     floor less 1 cm (tools/bench/robustness.hpp says why those bounds).
+//     floor less 1 cm (tools/bench/robustness.hpp says why those bounds);
+//   - no body's motion reverses at every physics step (a period-2 cycle, 8 steps in a row: the
+//     step's Nyquist mode, no motion of these scenes; robustness.hpp).
 // A check that cannot hold under a perturbation for a physical reason (the offset is larger than
 // the expectation's tolerance, a pinch with no torque about its axis, a device's workspace) is
 // listed in robustness_known.hpp with that reason, and the test checks that it still fails, and
@@ -70,6 +72,7 @@ std::vector<std::pair<std::string, std::string>> failures(const Outcome& o) {
   if (!o.error.empty()) out.emplace_back(kRan, o.error);
   if (!o.nonfinite.empty()) out.emplace_back(kFinite, "first at " + o.nonfinite);
   if (o.left_scene()) out.emplace_back(kInScene, o.left_scene_detail());
+  if (o.period_two()) out.emplace_back(kSmooth, o.period_two_detail());
   for (const auto& e : o.expectations)
     if (!e.passed) out.emplace_back(e.what, e.detail);
   return out;

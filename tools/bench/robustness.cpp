@@ -47,6 +47,29 @@ std::vector<BodyPath> body_paths(const std::string& trace, const Model& model) {
       if (!(turn <= b.max_turn)) b.max_turn = turn;
     }
     if (p.size() >= 3) b.final_position = Vec3(p[p.size() - 3], p[p.size() - 2], p[p.size() - 1]);
+    // Period-2 cycles: per component, the run of consecutive rows that each reverse the
+    // previous row's sign with both above the threshold.
+    for (const char* quantity : {"velocity", "angular_velocity"}) {
+      const bool spin = std::string(quantity) == "angular_velocity";
+      const double threshold = spin ? kFlipSpin : kFlipSpeed;
+      const std::vector<double> v = recordings::read_dataset(trace, at + "/" + quantity).values;
+      for (int axis = 0; axis < 3; ++axis) {
+        int run = 0;
+        double peak = 0.0;
+        for (std::size_t row = 1; 3 * row + 2 < v.size(); ++row) {
+          const double before = v[3 * (row - 1) + axis], now = v[3 * row + axis];
+          const bool flip = before * now < 0.0 && std::abs(before) > threshold && std::abs(now) > threshold;
+          run = flip ? run + 1 : 0;
+          peak = flip ? std::max(peak, std::max(std::abs(before), std::abs(now))) : 0.0;
+          if (run > b.flips) {
+            b.flips = run;
+            b.flip_at = row < time.size() ? time[row] : 0.0;
+            b.flip_peak = peak;
+            b.flip_what = std::string(quantity) + " " + "xyz"[axis];
+          }
+        }
+      }
+    }
     for (std::size_t row = 0; 3 * row + 2 < p.size(); ++row) {
       const Vec3 x(p[3 * row], p[3 * row + 1], p[3 * row + 2]);
       const double excursion = (x - body.position).norm();
@@ -124,6 +147,22 @@ const scripting::ExpectationResult& Outcome::expectation(const std::string& what
   for (const scripting::ExpectationResult& e : expectations)
     if (e.what.find(what) != std::string::npos) return e;
   throw std::out_of_range(scenario + ": no expectation contains '" + what + "'");
+}
+
+bool Outcome::period_two() const {
+  return std::any_of(bodies.begin(), bodies.end(), [](const BodyPath& b) { return b.flips >= kFlipSteps; });
+}
+
+std::string Outcome::period_two_detail() const {
+  std::string out;
+  for (const BodyPath& b : bodies) {
+    if (b.flips < kFlipSteps) continue;
+    char text[200];
+    std::snprintf(text, sizeof text, "%s %s reversed at %d physics steps in a row, up to %.3g, until %.3g s",
+                  b.name.c_str(), b.flip_what.c_str(), b.flips, b.flip_peak, b.flip_at);
+    out += (out.empty() ? "" : "; ") + std::string(text);
+  }
+  return out;
 }
 
 const BodyPath& Outcome::body(const std::string& name) const {

@@ -25,6 +25,21 @@ namespace graspsim::robustness {
 inline constexpr double kSceneRadius = 1.0;    // m
 inline constexpr double kFloorMargin = 0.01;   // m
 
+// A period-2 cycle: a velocity component of a body that reverses sign at every physics step,
+// above kFlipSpeed (m/s) or kFlipSpin (rad/s), for kFlipSteps steps in a row. That is the step's
+// own Nyquist mode (a period of two steps: 25 Hz at 50 Hz), which an explicit step shows when a
+// coupled mode is too stiff for it (its eigenvalue near or beyond -1: the lift rocking at
+// 11 rad/s). It is no motion of the scene: a physical oscillation sampled every step reverses at
+// every step only near half the physics rate, far above the soft couplings of the library's
+// scenes (two 400 N/m fingers on a 0.4 kg box: sqrt(2 k / m) = 45 rad/s, 7 Hz, a reversal every
+// 3.5 steps at 50 Hz), and backward Euler damps what it cannot resolve without alternating (its
+// eigenvalues 1 / (1 + i w h) have a positive real part). Eight reversals in a row (0.16 s at
+// 50 Hz) are no transient of a settling contact; the thresholds are a hundred times the speeds
+// the scenarios call "at rest" (0.1 mm/s and 1e-3 rad/s in their checks).
+inline constexpr int kFlipSteps = 8;            // 1
+inline constexpr double kFlipSpeed = 0.01;     // m/s
+inline constexpr double kFlipSpin = 0.1;       // rad/s
+
 struct Perturbation {
   double jitter = 0.0;                    // m: each waypoint offset component uniform in [-jitter, jitter)
   std::uint64_t seed = 0;                 // the jitter's seed
@@ -40,6 +55,11 @@ struct BodyPath {
   double left_at = -1.0;         // s: first physics row outside the scene (-1: never)
   double max_turn = 0.0;         // rad: largest angle of its rotation from the initial orientation
   Vec3 final_position{0.0, 0.0, 0.0};   // m: centre at the last physics row
+  int flips = 0;                 // 1: longest run of physics steps over which one velocity
+                                 //    component reversed at every step, above kFlipSpeed/kFlipSpin
+  double flip_at = -1.0;         // s: when the longest such run ended (-1: none)
+  double flip_peak = 0.0;        // m/s or rad/s: the largest |component| in it
+  std::string flip_what;         // "angular_velocity y" ...
 };
 
 struct Outcome {
@@ -53,6 +73,8 @@ struct Outcome {
   int most_fingers_on_a_body = 0; // largest number of fingers touching one body at one haptic tick
   double worst_excursion() const;   // m: over the bodies
   bool left_scene() const;          // some body left it
+  bool period_two() const;          // some body had a period-2 cycle of kFlipSteps steps or more
+  std::string period_two_detail() const;   // "box angular_velocity y reversed 52 steps in a row ..."
   std::string left_scene_detail() const;   // "rod left at 1.2 s: 35.3 m from its start" ("" if none)
   // The result of the expectation whose sentence contains `what`; throws std::out_of_range if none.
   const scripting::ExpectationResult& expectation(const std::string& what) const;

@@ -38,6 +38,7 @@ struct ScenarioTally {
 const char* kRan = "ran to its end (no divergence, no script error)";
 const char* kFinite = "no NaN or infinity anywhere in the trace";
 const char* kInScene = "every body stays in the scene (1 m; floor - 1 cm)";
+const char* kSmooth = "no period-2 cycle (a motion reversing every physics step)";
 
 std::string cut(const std::string& text, std::size_t width) {
   return text.size() <= width ? text : text.substr(0, width - 3) + "...";
@@ -79,6 +80,7 @@ int run_robustness_case(const RobustnessOptions& o) {
         t.check(kRan).passed[integrator] += r.error.empty();
         t.check(kFinite).passed[integrator] += r.nonfinite.empty();
         t.check(kInScene).passed[integrator] += !r.left_scene();
+        t.check(kSmooth).passed[integrator] += !r.period_two();
         if (!(r.worst_excursion() <= t.worst[integrator])) {
           t.worst[integrator] = r.worst_excursion();
           t.worst_run[integrator] = r.label;
