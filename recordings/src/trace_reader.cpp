@@ -1,6 +1,8 @@
 // Read helpers for traces: open read-only, read one thing, close; HDF5 errors become TraceError.
 #include "graspsim/recordings/trace_reader.hpp"
 
+#include <algorithm>
+
 #include "h5.hpp"
 
 namespace graspsim::recordings {
@@ -188,6 +190,44 @@ Dataset read_dataset(const std::string& file, const std::string& path) {
     out.units = h5::read_string_attribute(where.object.get(), "units", context);
   }
   return out;
+}
+
+namespace {
+
+struct Visit {
+  std::vector<std::string> paths;
+  std::string context;
+  std::string error;   // the first failure (an exception may not cross the HDF5 C frames)
+};
+
+herr_t visit_object(hid_t file, const char* name, const H5O_info_t* info, void* data) {
+  auto* visit = static_cast<Visit*>(data);
+  if (info->type != H5O_TYPE_DATASET) return 0;
+  const std::string path = std::string("/") + name;
+  try {
+    h5::Handle d = h5::checked(H5Dopen2(file, name, H5P_DEFAULT), H5Dclose, visit->context + ": cannot open " + quoted(path));
+    const std::vector<std::string> members = h5::member_names(d.get(), visit->context);
+    if (members.empty()) visit->paths.push_back(path);
+    for (const std::string& m : members) visit->paths.push_back(path + "/" + m);
+  } catch (const TraceError& e) {
+    visit->error = e.what();
+    return -1;
+  }
+  return 0;
+}
+
+}  // namespace
+
+std::vector<std::string> list_datasets(const std::string& file) {
+  h5::Lock lock;
+  h5::Quiet quiet;
+  h5::Handle handle = open_file(file);
+  Visit visit{{}, "trace " + quoted(file), ""};
+  const herr_t status = H5Ovisit2(handle.get(), H5_INDEX_NAME, H5_ITER_INC, visit_object, &visit, H5O_INFO_BASIC);
+  if (!visit.error.empty()) throw TraceError(visit.error);
+  h5::check(status, visit.context + ": cannot list its datasets");
+  std::sort(visit.paths.begin(), visit.paths.end());
+  return visit.paths;
 }
 
 namespace {

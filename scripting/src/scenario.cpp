@@ -10,6 +10,7 @@
 
 #include <lua.hpp>
 
+#include "jitter.hpp"
 #include "lua_convert.hpp"
 #include "lua_trajectory.hpp"
 #include "messages.hpp"
@@ -146,6 +147,7 @@ Scenario Scenario::load_source(const std::string& source, const std::string& pat
       s.trajectories_.push_back(TrajectorySpec{std::move(t.waypoints), t.interpolation, t.function_ref});
       if (t.function_ref != 0) s.uses_view_ = s.uses_view_ || takes_view(state, t.function_ref);
     }
+    s.apply_jitter(options.jitter);
     // Trajectory and expectation functions draw from the scenario's own seed.
     lua.seed_random(static_cast<std::int64_t>(s.seed_));
   } catch (const detail::ConversionError& e) {
@@ -154,6 +156,41 @@ Scenario Scenario::load_source(const std::string& source, const std::string& pat
     throw ScenarioError(detail::with_context(e.what(), path, ""));
   }
   return s;
+}
+
+void Scenario::apply_jitter(const Jitter& jitter) {
+  if (!(jitter.amplitude >= 0.0) || !std::isfinite(jitter.amplitude)) {
+    throw detail::ConversionError("--jitter " + detail::format_short(jitter.amplitude) +
+                                  ": the amplitude must be a finite length >= 0 m");
+  }
+  jitter_ = jitter;
+  if (jitter.amplitude == 0.0) return;
+  for (std::size_t f = 0; f < trajectories_.size(); ++f) {
+    TrajectorySpec& spec = trajectories_[f];
+    const bool function = spec.function_ref != 0;
+    std::vector<Vec3> offsets = detail::jitter_offsets(jitter, f, function ? 1 : spec.waypoints.size());
+    if (function) {
+      spec.offset_function = true;
+      spec.offset = offsets[0];
+    } else {
+      for (std::size_t k = 0; k < offsets.size(); ++k) spec.waypoints[k].position += offsets[k];
+    }
+    jitter_offsets_.push_back(std::move(offsets));
+  }
+}
+
+std::vector<std::string> Scenario::jitter_lines() const {
+  std::vector<std::string> lines;
+  for (std::size_t f = 0; f < jitter_offsets_.size(); ++f) {
+    const bool function = trajectories_[f].function_ref != 0;
+    for (std::size_t k = 0; k < jitter_offsets_[f].size(); ++k) {
+      const Vec3& o = jitter_offsets_[f][k];
+      lines.push_back(model_.fingers[f].name + (function ? " function: " : " waypoint " + std::to_string(k + 1) + ": ") +
+                      detail::format_exact(o.x()) + " " + detail::format_exact(o.y()) + " " +
+                      detail::format_exact(o.z()));
+    }
+  }
+  return lines;
 }
 
 std::unique_ptr<hw::Trajectory> Scenario::make_trajectory(std::size_t finger) const {
@@ -165,9 +202,10 @@ std::unique_ptr<hw::Trajectory> Scenario::make_trajectory(std::size_t finger) co
   if (spec.function_ref == 0) {
     return std::make_unique<hw::WaypointTrajectory>(spec.waypoints, spec.interpolation);
   }
-  auto lua = std::make_unique<detail::LuaTrajectory>(*lua_, spec.function_ref, path_,
-                                                     finger_label(finger, model_.fingers[finger].name));
-  if (wrapper_) return wrapper_(finger, std::move(lua));
+  std::unique_ptr<hw::Trajectory> lua = std::make_unique<detail::LuaTrajectory>(
+      *lua_, spec.function_ref, path_, finger_label(finger, model_.fingers[finger].name));
+  if (wrapper_) lua = wrapper_(finger, std::move(lua));
+  if (spec.offset_function) return std::make_unique<detail::OffsetTrajectory>(std::move(lua), spec.offset);
   return lua;
 }
 

@@ -92,3 +92,47 @@ TEST_CASE("graspsim_bench --quick writes the work-precision CSV and the stabilit
     CHECK(std::strtod(stab[i][2].c_str(), nullptr) > 0.0);
   }
 }
+
+// The robustness case on one scenario, two seeds: robustness.csv has, per integrator, one row per
+// expectation (the lift has 5) and per run check (4), each passed in at most `runs` runs, and the
+// worst body excursion, a finite positive length (the lift moves its box 5 cm at least).
+TEST_CASE("graspsim_bench --cases robustness writes pass rates per check and integrator", "[bench]") {
+  const std::string dir = GRASPSIM_TEST_TMP "/bench-smoke-robustness";
+  std::filesystem::remove_all(dir);
+  const std::string cmd = std::string(GRASPSIM_BENCH) + " --cases robustness --seeds 2 --scenarios two_finger_lift --out " +
+                          dir + " > " + dir + ".log 2>&1";
+  REQUIRE(std::system(cmd.c_str()) == 0);
+  // A check's sentence is quoted (it may hold commas): split outside quotes.
+  std::vector<std::vector<std::string>> rows;
+  std::ifstream in(dir + "/robustness.csv");
+  for (std::string line; std::getline(in, line);) {
+    std::vector<std::string> cells(1);
+    bool quoted = false;
+    for (char c : line) {
+      if (c == '"') quoted = !quoted;
+      else if (c == ',' && !quoted) cells.emplace_back();
+      else cells.back() += c;
+    }
+    rows.push_back(cells);
+  }
+  REQUIRE(rows.size() == 1 + 2 * (5 + 4 + 1));
+  CHECK(rows[0] == std::vector<std::string>{"scenario", "integrator", "check", "passed", "runs", "value"});
+  std::set<std::string> integrators;
+  for (std::size_t i = 1; i < rows.size(); ++i) {
+    const auto& r = rows[i];
+    INFO("row " << i << ": " << r[2]);
+    REQUIRE(r.size() == 6);
+    CHECK(r[0] == "two_finger_lift");
+    integrators.insert(r[1]);
+    if (r[2] == "worst body excursion m") {
+      CHECK(finite_number(r[5]));
+      CHECK(std::strtod(r[5].c_str(), nullptr) > 0.05);
+    } else {
+      const long passed = std::strtol(r[3].c_str(), nullptr, 10);
+      CHECK(r[4] == "2");
+      CHECK(passed >= 0);
+      CHECK(passed <= 2);
+    }
+  }
+  CHECK(integrators == std::set<std::string>{"paper", "implicit"});
+}

@@ -489,6 +489,23 @@ TEST_CASE("table returns the same object for the same group", "[trace_writer]") 
   CHECK_FALSE(has_object(file, "/physics/objects/box"));
 }
 
+// list_datasets names every column of every table, nested tables (/devices/<finger>) included,
+// sorted, each one a path read_dataset reads.
+TEST_CASE("list_datasets lists every column read_dataset reads", "[trace_reader]") {
+  const std::string file = tmp_path("list.h5");
+  TraceWriter writer(file);
+  writer.table("servo").add_column("tick", 1, DType::kInt64, "tick");
+  writer.table("servo").add_column("fingers/thumb/hip", 3, DType::kFloat64, "m");
+  writer.table("devices/thumb").add_column("force", 3, DType::kFloat64, "N");
+  writer.close("complete");
+  const std::vector<std::string> paths = list_datasets(file);
+  CHECK(paths == std::vector<std::string>{"/devices/thumb/force", "/servo/fingers/thumb/hip", "/servo/tick"});
+  for (const std::string& p : paths) CHECK_NOTHROW(read_dataset(file, p));
+  const std::string text = tmp_path("list_not_hdf5.txt");
+  std::ofstream(text) << "x\n";
+  CHECK_THROWS_AS(list_datasets(text), TraceError);
+}
+
 // An integer column takes only integers in its type's range; anything else is a bug upstream
 // and is reported with the dataset and row instead of being silently truncated or wrapped.
 TEST_CASE("a non-integer or out-of-range value in an integer column throws on flush",

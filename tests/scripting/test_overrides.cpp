@@ -173,6 +173,6 @@ TEST_CASE("math.random is seeded from --set seed while loading and from the scen
   CHECK(s.seed() == 3);
   CHECK(s.make_trajectory(0)->position(0.0).x() == first);
   CHECK(load({"seed=9"}).make_trajectory(0)->position(0.0).x() != first);
-  CHECK_THAT(load_error(path, LoadOptions{{"seed=-1"}, {}, {}}),
+  CHECK_THAT(load_error(path, LoadOptions{{"seed=-1"}, {}, {}, {}}),
              Contains("--set seed=-1: seed must be an integer >= 0"));
 }

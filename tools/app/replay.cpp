@@ -186,6 +186,12 @@ ReplayPlan load(const std::string& trace, const ReplayOptions& options) {
   scripting::LoadOptions load;
   load.sets = plan.overrides;
   load.base_directory = options.scenario_dir;
+  // A jittered run (README.md "Perturbed waypoints"): the same offsets again, so that the
+  // scripts that run alongside the recorded samples, and the new trace's attributes, are the run's.
+  if (recordings::has_attribute(trace, "/", "jitter_amplitude")) {
+    load.jitter.amplitude = recordings::read_double_attribute(trace, "/", "jitter_amplitude");
+    load.jitter.seed = static_cast<std::uint64_t>(recordings::read_int_attribute(trace, "/", "jitter_seed"));
+  }
   const std::string base = !options.scenario_dir.empty() ? options.scenario_dir
                          : fs::path(plan.scenario_path).parent_path().string();
   try {
@@ -202,6 +208,15 @@ ReplayPlan load(const std::string& trace, const ReplayOptions& options) {
     throw ReplayError(message);
   }
   const Model& model = plan.scenario->model();
+  if (!plan.what_if && recordings::has_attribute(trace, "/", "jitter_offsets")) {
+    std::string offsets;
+    for (const std::string& line : plan.scenario->jitter_lines()) offsets += line + "\n";
+    if (offsets != recordings::read_string_attribute(trace, "/", "jitter_offsets")) {
+      plan.notes.push_back("the jitter offsets drawn again from jitter_seed differ from the recorded "
+                           "jitter_offsets (another generator?); the fingers follow their recorded "
+                           "samples, so only the scripts that run alongside see other waypoints");
+    }
+  }
 
   // The recorded samples are at the recorded rates: a replay at other rates is not this motion.
   const std::pair<const char*, int> rates[] = {

@@ -211,6 +211,13 @@ RunResult run_scenario(const scripting::Scenario& scenario, const RunOptions& op
   writer.set_attribute("overrides", join_lines(options.overrides));
   writer.set_attribute("integrator", std::string(model.integrator == Integrator::kPaper ? "paper" : "implicit"));
   writer.set_attribute("parameters", join_lines(scenario.parameters()));
+  // Perturbed waypoints (README.md "Perturbed waypoints"): a replay loads the scenario with the
+  // same jitter; the offsets themselves, to read and to check the generator against.
+  if (scenario.jitter().amplitude > 0.0) {
+    writer.set_attribute("jitter_amplitude", scenario.jitter().amplitude);
+    writer.set_attribute("jitter_seed", static_cast<std::int64_t>(scenario.jitter().seed));
+    writer.set_attribute("jitter_offsets", join_lines(scenario.jitter_lines()));
+  }
   writer.set_attribute("rate_servo", std::int64_t{model.rates.servo});
   writer.set_attribute("rate_haptic", std::int64_t{model.rates.haptic});
   writer.set_attribute("rate_physics", std::int64_t{model.rates.physics});

@@ -20,6 +20,7 @@
 #include "bench/accuracy.hpp"
 #include "bench/cases.hpp"
 #include "bench/lift.hpp"
+#include "bench/robustness_case.hpp"
 #include "bench/row.hpp"
 
 using namespace graspsim;
@@ -32,6 +33,8 @@ const std::vector<std::string> kCases = [] {
   c.insert(c.end(), kAccuracyCases.begin(), kAccuracyCases.end());
   return c;
 }();
+// Cases run only when --cases names them: robustness runs thousands of scenarios (minutes).
+const std::vector<std::string> kOnRequest{"robustness"};
 constexpr double kSpinEnergyGainBound = 0.05;   // 1: relative energy gain over 10 s that marks a
                                                 //    torque-free run unstable
 constexpr double kCornerStiffness = 300.0;      // N/m per vertex: corner_drop's rows (stable at
@@ -43,18 +46,23 @@ struct Options {
   std::string out = "bench-out";
   std::vector<std::string> cases = kCases;
   std::string lift = GRASPSIM_SOURCE_DIR "/scenarios/two_finger_lift.lua";
+  RobustnessOptions robustness;   // --seeds, --jitter, --set, --scenarios
 };
 
 [[noreturn]] void usage(const std::string& error) {
   std::cerr << "graspsim_bench: " << error << "\n"
             << "usage: graspsim_bench [--quick] [--repeats N] [--out DIR] [--cases a,b,...] [--lift FILE.lua]\n"
-            << "cases: spin_flip, gyro_precession, corner_drop, two_finger_lift, cube_rest, slope_stick, slope_slide, cube_settle\n";
+            << "                      [--seeds N] [--jitter M] [--set NAME=VALUE]... [--scenarios a,b,...]\n"
+            << "cases: spin_flip, gyro_precession, corner_drop, two_finger_lift, cube_rest, slope_stick, slope_slide,\n"
+            << "       cube_settle (the default: all of them);\n"
+            << "       robustness (only when named: --seeds jitter seeds per scenario, default 100, --quick 5;\n"
+            << "       --jitter amplitude in m, default 0.5e-3; --set for every run; --scenarios a subset)\n";
   std::exit(2);
 }
 
 Options parse(int argc, char** argv) {
   Options o;
-  bool repeats_set = false;
+  bool repeats_set = false, seeds_set = false;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     const auto value = [&]() -> std::string {
@@ -69,6 +77,23 @@ Options parse(int argc, char** argv) {
       if (*end != '\0' || n < 1 || n > 1000) usage("--repeats wants a whole number 1..1000, got '" + v + "'");
       o.repeats = static_cast<int>(n);
       repeats_set = true;
+    } else if (a == "--seeds") {
+      const std::string v = value();
+      char* end = nullptr;
+      const long n = std::strtol(v.c_str(), &end, 10);
+      if (*end != '\0' || n < 1 || n > 100000) usage("--seeds wants a whole number 1..100000, got '" + v + "'");
+      o.robustness.seeds = static_cast<int>(n);
+      seeds_set = true;
+    } else if (a == "--jitter") {
+      const std::string v = value();
+      char* end = nullptr;
+      o.robustness.jitter = std::strtod(v.c_str(), &end);
+      if (*end != '\0' || !(o.robustness.jitter > 0.0) || !std::isfinite(o.robustness.jitter))
+        usage("--jitter wants an amplitude in m > 0, got '" + v + "'");
+    } else if (a == "--set") o.robustness.sets.push_back(value());
+    else if (a == "--scenarios") {
+      std::stringstream ss(value());
+      for (std::string c; std::getline(ss, c, ',');) o.robustness.scenarios.push_back(c);
     } else if (a == "--out") o.out = value();
     else if (a == "--lift") o.lift = value();
     else if (a == "--cases") {
@@ -76,7 +101,9 @@ Options parse(int argc, char** argv) {
       std::stringstream ss(value());
       std::string c;
       while (std::getline(ss, c, ',')) {
-        if (std::find(kCases.begin(), kCases.end(), c) == kCases.end()) usage("unknown case '" + c + "'");
+        if (std::find(kCases.begin(), kCases.end(), c) == kCases.end() &&
+            std::find(kOnRequest.begin(), kOnRequest.end(), c) == kOnRequest.end())
+          usage("unknown case '" + c + "'");
         o.cases.push_back(c);
       }
       if (o.cases.empty()) usage("--cases is empty");
@@ -84,6 +111,9 @@ Options parse(int argc, char** argv) {
     else usage("unknown argument '" + a + "'");
   }
   if (o.quick && !repeats_set) o.repeats = 1;
+  if (o.quick && !seeds_set) o.robustness.seeds = 5;
+  o.robustness.scenario_dir = GRASPSIM_SOURCE_DIR "/scenarios";
+  o.robustness.out = o.out;
   return o;
 }
 
@@ -216,6 +246,12 @@ int main(int argc, char** argv) {
   if (wants("corner_drop"))
     for (Gyroscopic g : kIntegrators)
       for (int rate : rates) boundaries.push_back({rate, g, corner_drop_boundary(rate, g), corner_drop_estimate(rate)});
+
+  if (wants("robustness")) {
+    const int status = run_robustness_case(opt.robustness);
+    if (status != 0) return status;
+    if (rows.empty() && boundaries.empty()) return 0;   // nothing else was asked for
+  }
 
   // ---- output -----------------------------------------------------------------------------
   std::error_code ec;

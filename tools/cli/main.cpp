@@ -1,6 +1,7 @@
 // The graspsim command line: run a scenario, write its trace, report its expectations.
 #include <atomic>
 #include <csignal>
+#include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -33,7 +34,7 @@ using graspsim::cli::kExitOk;
 
 constexpr const char* kUsage =
     "usage: graspsim run SCENARIO.lua [--out FILE.h5] [--duration S] [--set NAME=VALUE]...\n"
-    "                [--device FINGER=SPEC]... [--refuse-unstable]\n"
+    "                [--device FINGER=SPEC]... [--jitter A [--jitter-seed N]] [--refuse-unstable]\n"
     "       graspsim replay TRACE.h5 [--out NEW.h5] [--set NAME=VALUE]...\n"
     "       graspsim repair TRACE.h5\n"
     "       graspsim compare A.h5 B.h5 [--atol X] [--rtol X] [--tol PATTERN=ATOL[,RTOL]]...\n"
@@ -61,6 +62,14 @@ constexpr const char* kHelp =
     "                       hip and gimbal), sim-phantom[:MODEL], udp:HOST:PORT, phantom:NAME.\n"
     "                       With udp or phantom the run is paced in real time at the servo\n"
     "                       rate; every non-scripted device's samples go to /devices/FINGER\n"
+    "  --jitter A           move every waypoint of every finger's trajectory by its own\n"
+    "                       random offset, each of x, y, z uniform in [-A, A) m (A >= 0); a\n"
+    "                       trajectory given as a function (a feedback controller) is moved\n"
+    "                       by one constant offset per finger. The offsets go to the trace's\n"
+    "                       root attributes (jitter_amplitude, jitter_seed, jitter_offsets),\n"
+    "                       and a replay uses them again. Example: --jitter 0.5e-3\n"
+    "  --jitter-seed N      the jitter's seed, an integer 0 to 2^63 - 1 (default 0): the same\n"
+    "                       seed gives the same offsets on every machine\n"
     "  --compress N         deflate the trace at level N (1..9; default none)\n"
     "  --refuse-unstable    stop the run at the first unstable mode the stability check\n"
     "                       finds (as the scenario field stability = \"refuse\"), exit 2;\n"
@@ -167,12 +176,20 @@ bool parse_number(const std::string& text, double& out) {
   return !text.empty() && end && *end == '\0' && std::isfinite(out);
 }
 
+// A decimal integer from 0 to 2^63 - 1 (the trace stores it as int64), nothing else.
+bool parse_seed(const std::string& text, std::uint64_t& out) {
+  if (text.empty() || text.size() > 19 || text.find_first_not_of("0123456789") != std::string::npos) return false;
+  out = std::strtoull(text.c_str(), nullptr, 10);
+  return out <= static_cast<std::uint64_t>(INT64_MAX);
+}
+
 int run_command(const std::vector<std::string>& args) {
   std::string scenario_path, out;
   graspsim::scripting::LoadOptions load;
   int compression = 0;
   bool quiet = false, refuse_unstable = false;
   std::vector<std::string> device_options;
+  bool jitter_seed_given = false;
   for (std::size_t i = 0; i < args.size(); ++i) {
     const std::string& a = args[i];
     const auto value = [&]() -> const std::string* {
@@ -203,6 +220,15 @@ int run_command(const std::vector<std::string>& args) {
       if (!v || v->find('=') == std::string::npos || v->front() == '=')
         return bad_input("--set needs NAME=VALUE" + (v ? " (got '" + *v + "')" : std::string()));
       load.sets.push_back(*v);
+    } else if (a == "--jitter") {
+      const std::string* v = value();
+      if (!v || !parse_number(*v, load.jitter.amplitude) || !(load.jitter.amplitude >= 0.0))
+        return bad_input("--jitter needs an amplitude in m, a number >= 0" + (v ? " (got '" + *v + "')" : std::string()));
+    } else if (a == "--jitter-seed") {
+      const std::string* v = value();
+      if (!v || !parse_seed(*v, load.jitter.seed))
+        return bad_input("--jitter-seed needs an integer from 0 to 2^63 - 1" + (v ? " (got '" + *v + "')" : std::string()));
+      jitter_seed_given = true;
     } else if (a == "--compress") {
       const std::string* v = value();
       double level = 0.0;
@@ -222,6 +248,8 @@ int run_command(const std::vector<std::string>& args) {
     }
   }
   if (scenario_path.empty()) return bad_input(std::string("run needs a scenario file\n") + kUsage);
+  if (jitter_seed_given && !(load.jitter.amplitude > 0.0))
+    return bad_input("--jitter-seed needs --jitter A with A > 0 (without an amplitude nothing is drawn)");
 
   std::optional<graspsim::scripting::Scenario> scenario;
   try {
@@ -297,6 +325,9 @@ int run_command(const std::vector<std::string>& args) {
     std::printf("  wall time   %.3g s (%.0fx real time)\n", result.wall,
                 result.wall > 0 ? result.simulated / result.wall : 0.0);
     std::printf("  trace       %s (%s)\n", result.trace_path.c_str(), ec ? "?" : human_bytes(size).c_str());
+    if (scenario->jitter().amplitude > 0.0)
+      std::printf("  jitter      waypoints moved by up to %g m per axis, seed %llu (trace: jitter_offsets)\n",
+                  scenario->jitter().amplitude, static_cast<unsigned long long>(scenario->jitter().seed));
     if (pacer) std::printf("  pacing      %s%s\n", result.pacing.c_str(), options.realtime ? ", SCHED_FIFO" : "");
   }
   if (!result.error.empty()) {

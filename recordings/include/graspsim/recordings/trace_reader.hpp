@@ -24,6 +24,10 @@ struct Dataset {
 // for SWMR writing) is opened as a SWMR reader. Throws TraceError naming the file and the path if the
 // file is not an HDF5 file, the path is missing or not a dataset, or its type is not one of DType.
 Dataset read_dataset(const std::string& file, const std::string& path);
+// Every path read_dataset reads in the file, sorted: each column of each table ("/physics/tick",
+// "/physics/objects/box/position", "/devices/thumb/force", ...) and each plain dataset. Throws
+// TraceError if the file cannot be opened as HDF5.
+std::vector<std::string> list_datasets(const std::string& file);
 // Attribute `name` of the group or dataset `object_path` ("/" for the root).
 std::string read_string_attribute(const std::string& file, const std::string& object_path,
                                   const std::string& name);

@@ -71,6 +71,16 @@ struct Snapshot {
   std::vector<FingerSnapshot> fingers;   // Model::fingers order
 };
 
+// Perturbed waypoints (`graspsim run --jitter A --jitter-seed N`, README.md "Perturbed
+// waypoints"): every waypoint of every finger's trajectory moved by its own random offset, each
+// component uniform in [-amplitude, amplitude); a trajectory given as a function gets one constant
+// offset per finger instead. Positions only (a waypoint's gimbal pitch is kept). The generator
+// (scripting/src/jitter.hpp) gives the same offsets on every machine for a seed.
+struct Jitter {
+  double amplitude = 0.0;   // m, >= 0 and finite; 0: no jitter
+  std::uint64_t seed = 0;   // 1
+};
+
 struct LoadOptions {
   // "--set name=value" overrides, applied to the scenario table before it is converted.
   std::vector<std::string> sets;
@@ -79,6 +89,9 @@ struct LoadOptions {
   // Directory that relative file names in the scenario (mesh `file`s) are read from; "" means
   // the scenario file's own directory. A replay sets it: its source comes from a trace.
   std::string base_directory;
+  // Applied to the trajectories after the overrides, so `--set fingers.thumb.trajectory.1.p=...`
+  // moves the waypoint that is then jittered.
+  Jitter jitter;
 };
 
 class Scenario {
@@ -109,6 +122,14 @@ class Scenario {
   const std::vector<Expectation>& expectations() const { return expectations_; }
   // Every parameter after overrides, as sorted "path = value" lines, for the trace.
   const std::vector<std::string>& parameters() const { return parameters_; }
+  // The jitter it was loaded with, and the offsets it gave (m, world), per finger: one per
+  // waypoint, or one for a function trajectory; empty without jitter. `parameters()` keeps the
+  // waypoints as written: the offsets are added to them.
+  const Jitter& jitter() const { return jitter_; }
+  const std::vector<std::vector<Vec3>>& jitter_offsets() const { return jitter_offsets_; }
+  // The offsets as lines for the trace's root `jitter_offsets`, every number at %.17g (it reads
+  // back to the same double): "thumb waypoint 1: dx dy dz" or "finger function: dx dy dz".
+  std::vector<std::string> jitter_lines() const;
 
   // The scripted trajectory of finger i (waypoints, or a Lua function of time). Lua errors while
   // it runs are thrown as ScenarioError with file:line and a traceback.
@@ -143,6 +164,8 @@ class Scenario {
 
  private:
   Scenario();
+  // Moves the trajectories by the jitter's offsets and keeps them (load_source, after conversion).
+  void apply_jitter(const Jitter& jitter);
   std::string path_, source_, name_, description_;
   Model model_;
   double duration_ = 0.0;
@@ -157,8 +180,12 @@ class Scenario {
     std::vector<hw::Waypoint> waypoints;
     hw::Interpolation interpolation = hw::Interpolation::kMinimumJerk;
     int function_ref = 0;
+    bool offset_function = false;    // a function trajectory moved by `offset` (jitter)
+    Vec3 offset{0.0, 0.0, 0.0};      // m, world
   };
   std::vector<TrajectorySpec> trajectories_;
+  Jitter jitter_;
+  std::vector<std::vector<Vec3>> jitter_offsets_;   // per finger (see jitter_offsets())
   std::unique_ptr<LuaSandbox> lua_;   // owns the Lua state the functions live in
   mutable TrajectoryWrapper wrapper_;   // set by a paced run while it builds devices
   friend class ScenarioBuilder;
