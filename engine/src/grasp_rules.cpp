@@ -115,10 +115,17 @@ AxisRule plan_axis_rule(const Model& model, const State& state, int body, double
   double turning = drop + (contact_torque + p.cross(contact_force)).dot(u);
   if (std::abs(turning) <= model.grasp.dead_band) turning = 0.0;   // section 5, about u too
   rule.torsion = turning;
+  // Implicit in the turn too: the gravity torque's stiffness about the axis, K = -dT/dtheta =
+  // -[(u x p) x m g s] . u (p turns as u x p), enters as backward Euler does, so the rule cannot
+  // overshoot the hanging position however small the pads' c_t or slow the physics (the paper's
+  // explicit turn overshoots once h K / c_t > 1 and grows once it passes 2).
+  const Vec3 weight = bp.mass * model.gravity * (1.0 - grasp.area / model.grasp.critical_area);   // N
+  const double stiffness = std::max(0.0, -(u.cross(p).cross(weight)).dot(u));                     // N m/rad
   if (model.grasp.torsional_damping > 0.0) {
-    rule.turn = dt * turning / model.grasp.torsional_damping;
+    rule.turn = dt * turning / (model.grasp.torsional_damping + dt * stiffness);
   } else {
-    rule.rate = bs.angular_velocity.dot(u) + dt * turning / axis_inertia(bp, bs, grasp.go_first, u);
+    const double inertia = axis_inertia(bp, bs, grasp.go_first, u);   // kg m^2
+    rule.rate = (inertia * bs.angular_velocity.dot(u) + dt * turning) / (inertia + dt * dt * stiffness);
   }
   return rule;
 }

@@ -132,8 +132,10 @@ void Simulation::implicit_solve(double pitch_change) {
 }
 
 // One body after the solve: its velocity change as the force and torque that make it, its grasp
-// rule's rate about the axis set directly (so that the dead band, on the rest of the torque, leaves
-// it), the dead band, the move, then the rule's turn.
+// rule's rate about the axis set directly, the move, then the rule's turn. The dead band (section
+// 5) acts on the rule's torque about the axis only (plan_axis_rule): the paper's band stops the
+// residual torque reversing at every explicit step, which this step never does, and on the whole
+// torque it would throw away the solve's damping of a body turning slowly, keeping it turning.
 void Simulation::implicit_body_step(int b, TickRecord& record) {
   const BodyParams& bp = model_.bodies[b];
   BodyState& bs = state_.bodies[b];
@@ -153,7 +155,6 @@ void Simulation::implicit_body_step(int b, TickRecord& record) {
   const Vec3 force = (bp.mass / h) * (implicit_.velocity(b) - v0_[b]);
   Vec3 torque = (R * bp.inertia.asDiagonal() * R.transpose()) * ((implicit_.angular_velocity(b) - w0) / h);
   bs.angular_velocity = w0;
-  dead_band(model_.grasp.dead_band, torque);
   rec.force = force;
   rec.torque = torque;
   mark_stepped(bs);

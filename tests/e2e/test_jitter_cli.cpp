@@ -47,7 +47,7 @@ std::vector<double> row(const std::string& trace, const std::string& dataset, st
 // The lift's thumb starts at its first waypoint (held before t = 0's segment), so its HIP at
 // servo tick 0 is that waypoint plus the recorded offset: the difference from the plain run's is
 // the offset up to one rounding of a coordinate of about 0.1 m (ulp 1.4e-17 m; 1e-16 m allowed).
-TEST_CASE("graspsim run --jitter moves the waypoints by the recorded offsets; the same seed, the same trace",
+TEST_CASE("graspsim run --jitter moves the waypoints by the recorded offsets, and the same seed gives the same trace",
           "[e2e][cli][jitter]") {
   const std::string plain = kTmp + "/jitter_plain.h5", a = kTmp + "/jitter_a.h5", b = kTmp + "/jitter_b.h5",
                     other = kTmp + "/jitter_other.h5";

@@ -52,7 +52,7 @@ TEST_CASE("jitter: the generator is splitmix64, bit for bit", "[scenario][jitter
 // correct generator with probability 6e-7). Every draw stays in [-a, a), and the extremes come
 // within 0.1% of both ends (the chance that N = 30000 uniform draws all miss a 0.1% band is
 // (1 - 5e-4)^30000 = 3e-7).
-TEST_CASE("jitter: offsets are uniform in [-a, a) per axis, for any amplitude and seed", "[scenario][jitter][law]") {
+TEST_CASE("jitter: offsets are uniform from -a to a per axis, for any amplitude and seed", "[scenario][jitter][law]") {
   const std::size_t n = 10000;   // offsets, 3 draws each
   for (double a : {1e-4, 5e-4, 2e-2}) {
     for (std::uint64_t seed : {0ULL, 7ULL, 123456789ULL}) {

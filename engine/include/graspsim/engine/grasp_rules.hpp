@@ -53,7 +53,9 @@ double gimbal_twist(const Model& model, int body, const TwoPointGrasp& grasp, do
 
 // The same two rules for the implicit step, which cannot take a rate set after its solve: the
 // rule is planned before it, as the rate the body must turn at about the grasp axis (a
-// constraint of the solve, w1 . u = rate) and a turn to make after the move.
+// constraint of the solve, w1 . u = rate) and a turn to make after the move. The gravity drop's
+// turn or rate is backward Euler in the angle about the axis: with K = -dT_u/dtheta >= 0,
+//   quasi-static  turn = h T_u / (c_t + h K)       inertial  w_u = (J w_u + h T_u) / (J + h^2 K)
 struct AxisRule {
   bool active = false;       // a two-point grasp under a torsion rule constrains the body
   TwoPointGrasp grasp;       // u: grasp.axis, through grasp.go_first
