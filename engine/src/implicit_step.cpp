@@ -115,6 +115,8 @@ void ImplicitStep::solve(const Model& model, const State& state, const std::vect
     v1_[b] = v0[b];
     w1_[b] = w0[b];
   }
+  u0_.resize(couplings.size());
+  for (std::size_t i = 0; i < couplings.size(); ++i) u0_[i] = relative_velocity(state, couplings[i], v0, w0);
   // Islands: awake bodies joined by a body point (a sleeping body stays put, as the world does).
   for (const Coupling& c : couplings) {
     if (c.a >= 0 && c.b >= 0 && awake[c.a] && awake[c.b]) {
@@ -145,9 +147,8 @@ void ImplicitStep::solve(const Model& model, const State& state, const std::vect
       bool slipped = false, released = false;
       for (int i : current_couplings_) {
         const Coupling& c = couplings[i];
-        const Vec3 u0 = relative_velocity(state, c, v0, w0);
         const Vec3 u1 = relative_velocity(state, c, v1_, w1_);
-        solved_[i] = constant_force(c, mode_[i], u0, slide_[i]) - response(c, mode_[i], slide_[i], h) * u1;
+        solved_[i] = constant_force(c, mode_[i], u0_[i], slide_[i]) - response(c, mode_[i], slide_[i], h) * u1;
         if (c.mu < 0.0 || mode_[i] != CouplingMode::kHold) continue;
         const double f_n = c.normal.dot(solved_[i]);
         const Vec3 f_t = solved_[i] - f_n * c.normal;
@@ -209,7 +210,7 @@ void ImplicitStep::assemble_and_solve(const Model& model, const State& state,
     const Coupling& c = couplings[i];
     if (mode_[i] == CouplingMode::kOff) continue;
     const Mat3 g = response(c, mode_[i], slide_[i], h);
-    Vec3 fc = constant_force(c, mode_[i], relative_velocity(state, c, v0, w0), slide_[i]);
+    Vec3 fc = constant_force(c, mode_[i], u0_[i], slide_[i]);
     if (c.a < 0) fc += g * c.world_velocity;   // the world side moves on: u1 = J q1 - v_world
     const bool in_b = c.b >= 0 && island_of_[c.b] >= 0;
     const bool in_a = c.a >= 0 && island_of_[c.a] >= 0;

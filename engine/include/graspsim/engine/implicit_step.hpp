@@ -106,6 +106,7 @@ class ImplicitStep {
   std::vector<Vec3> slide_;                 // 1, world, per coupling: unit direction of the sliding
                                             //    force while kSlip
   std::vector<Vec3> solved_;                // N, world, per coupling: force at the end of the step
+  std::vector<Vec3> u0_;                    // m/s, world, per coupling: relative velocity at the start
   std::vector<int> current_;                // the island being solved: its bodies, couplings
   std::vector<int> current_couplings_;
 };
