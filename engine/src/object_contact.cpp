@@ -56,10 +56,72 @@ Vec3 floor_point(const Shape& s, const Mat3& rotation, int k, bool& rolling) {
   return Vec3::Zero();
 }
 
+namespace {
+
+// One floor point of a body at this step, as the penalty law sees it (paper, section 4).
+struct FloorPoint {
+  Vec3 r;          // m, world: from the centre of mass
+  Vec3 x;          // m, world: the point
+  Vec3 x_t;        // m, world: its material point projected on the floor
+  Vec3 u_t;        // m/s, world: its material's velocity along the floor
+  double u_n;      // m/s: its velocity along the floor's normal (> 0 leaving)
+  double depth;    // m: under the floor (< 0 above)
+  double f_n;      // N: k depth - c u_n, not clamped
+  double viscous;  // N: c_v |u_t|, the viscous friction while slipping
+  bool rolling;    // the lowest point of a round surface, not a material point
+};
+
+// Floor point k of body `bp` in state `bs`, and its friction anchor updated: false (the point
+// made inactive) when it is above the floor by its approach over a step h or more, h max(0, -u_n)
+// + `reach` (0 for the paper's step: in contact only while under the floor). The anchor is kept
+// while the point stays active, started at the point when it becomes so, and moved onto the
+// friction circle by stick_slip_step with the normal force k depth - c u_n (0 if it pulls).
+bool track_floor_point(const BodyParams& bp, BodyState& bs, const ContactPair& pair, double floor_z, int k,
+                       double h, double reach, FloorPoint& p) {
+  VertexContact& vc = bs.floor_contacts[k];
+  p.r = floor_point(bp.shape, bs.rotation, k, p.rolling);
+  p.x = bs.position + p.r;
+  p.depth = floor_z - p.x.z();
+  const Vec3 u = bs.velocity + bs.angular_velocity.cross(p.r);   // m/s: velocity of the material there
+  if (p.depth <= -(h * std::max(0.0, -u.z()) + reach)) {
+    vc.active = false;
+    return false;
+  }
+  p.u_n = u.z();
+  p.f_n = pair.stiffness * p.depth - pair.damping * p.u_n;
+  // A vertex is its own material point; a rolling point's is the one under it last step.
+  const Vec3 x_m = (p.rolling && vc.active) ? Vec3(bs.position + bs.rotation * vc.material) : p.x;
+  p.x_t = Vec3(x_m.x(), x_m.y(), floor_z);
+  if (!vc.active) {
+    vc.active = true;
+    vc.slipping = false;
+    vc.anchor = p.x_t;
+  }
+  // Static coefficient while stuck, kinetic (plus viscous c |u_t|) while slipping, with the
+  // fingers' rule for sticking again (stick_slip_step), on the point's velocity over the floor.
+  p.u_t = Vec3(u.x(), u.y(), 0.0);
+  p.viscous = pair.viscous * p.u_t.norm();
+  const double pushing = std::max(0.0, p.f_n);   // N
+  vc.slipping = stick_slip_step(p.x_t, pair.mu * pushing / pair.stiffness,
+                                (pair.friction(true) * pushing + p.viscous) / pair.stiffness, p.u_t, vc.slipping,
+                                vc.anchor);
+  return true;
+}
+
+// After the point's force: a rolling point's stretch carried over to the new lowest point and
+// its material.
+void roll_on(BodyState& bs, const FloorPoint& p, double floor_z, VertexContact& vc) {
+  if (!p.rolling) return;
+  vc.anchor = Vec3(p.x.x(), p.x.y(), floor_z) + (vc.anchor - p.x_t);
+  vc.material = bs.rotation.transpose() * p.r;
+}
+
+}  // namespace
+
 int floor_contact(const Model& model, int body, BodyState& bs, Wrench& out) {
   out = Wrench{};
   const BodyParams& bp = model.bodies[body];
-  const ContactPair pair = contact_pair(bp.material, model.floor.material);
+  const ContactPair pair = floor_pair(model, body);
   const double floor_z = model.floor.height;
   int touching = 0;
   const int count = static_cast<int>(bs.floor_contacts.size());
@@ -80,45 +142,16 @@ int floor_contact(const Model& model, int body, BodyState& bs, Wrench& out) {
       vc.active = false;
       continue;
     }
-    bool rolling = false;
-    const Vec3 r = floor_point(bp.shape, bs.rotation, k, rolling);   // m: from centre of mass
-    const Vec3 x = bs.position + r;
-    const double depth = floor_z - x.z();
-    if (depth <= 0.0) {
-      vc.active = false;
-      continue;
-    }
+    FloorPoint p;
+    if (!track_floor_point(bp, bs, pair, floor_z, k, 0.0, 0.0, p)) continue;
     ++touching;
-    const Vec3 u = bs.velocity + bs.angular_velocity.cross(r);   // m/s: velocity of the material there
-    const double f_n = std::max(0.0, pair.stiffness * depth - pair.damping * u.z());
-    // A vertex is its own material point; a rolling point's is the one under it last step.
-    const Vec3 x_m = (rolling && vc.active) ? Vec3(bs.position + bs.rotation * vc.material) : x;
-    const Vec3 x_t(x_m.x(), x_m.y(), floor_z);
-    if (!vc.active) {
-      vc.active = true;
-      vc.slipping = false;
-      vc.anchor = x_t;
-    }
-    // Static coefficient while stuck, kinetic (plus viscous c |u_t|) while slipping, with the
-    // fingers' rule for sticking again (stick_slip_step), on the point's velocity over the floor.
-    const Vec3 u_t(u.x(), u.y(), 0.0);   // m/s
-    const double viscous = pair.viscous * u_t.norm();   // N, while slipping
-    vc.slipping = stick_slip_step(x_t, pair.mu * f_n / pair.stiffness,
-                                  (pair.friction(true) * f_n + viscous) / pair.stiffness, u_t,
-                                  vc.slipping, vc.anchor);
-    const double mu = pair.friction(vc.slipping);
-    const double limit_viscous = vc.slipping ? viscous : 0.0;
-    Vec3 f_t = pair.stiffness * (vc.anchor - x_t) - pair.damping * Vec3(u.x(), u.y(), 0.0);
-    const double limit = mu * f_n + limit_viscous;
-    const double f_t_norm = f_t.norm();
-    if (f_t_norm > limit) f_t *= limit / f_t_norm;
+    const double f_n = std::max(0.0, p.f_n);
+    Vec3 f_t = pair.stiffness * (vc.anchor - p.x_t) - pair.damping * p.u_t;
+    clamp_to_cone(pair.friction(vc.slipping) * f_n + (vc.slipping ? p.viscous : 0.0), f_t);
     const Vec3 f(f_t.x(), f_t.y(), f_n);
     out.force += f;
-    out.torque += r.cross(f);
-    if (rolling) {   // carry the stretch over to the new lowest point and its material
-      vc.anchor = Vec3(x.x(), x.y(), floor_z) + (vc.anchor - x_t);
-      vc.material = bs.rotation.transpose() * r;
-    }
+    out.torque += p.r.cross(f);
+    roll_on(bs, p, floor_z, vc);
   }
   return touching;
 }
@@ -131,47 +164,24 @@ int floor_couplings(const Model& model, int body, BodyState& bs, double h, std::
   int appended = 0;
   const int count = static_cast<int>(bs.floor_contacts.size());
   for (int k = 0; k < count; ++k) {
+    FloorPoint p;
+    if (!track_floor_point(bp, bs, pair, floor_z, k, h, reach, p)) continue;
     VertexContact& vc = bs.floor_contacts[k];
-    bool rolling = false;
-    const Vec3 r = floor_point(bp.shape, bs.rotation, k, rolling);   // m: from centre of mass
-    const Vec3 x = bs.position + r;
-    const double depth = floor_z - x.z();                            // m: < 0 above the floor
-    const Vec3 u = bs.velocity + bs.angular_velocity.cross(r);       // m/s
-    if (depth <= -(h * std::max(0.0, -u.z()) + reach)) {
-      vc.active = false;
-      continue;
-    }
-    const Vec3 x_m = (rolling && vc.active) ? Vec3(bs.position + bs.rotation * vc.material) : x;
-    const Vec3 x_t(x_m.x(), x_m.y(), floor_z);
-    if (!vc.active) {
-      vc.active = true;
-      vc.slipping = false;
-      vc.anchor = x_t;
-    }
-    const Vec3 u_t(u.x(), u.y(), 0.0);                 // m/s
-    const double f_n = pair.stiffness * depth - pair.damping * u.z();   // N, unclamped
-    const double viscous = pair.viscous * u_t.norm();   // N, while slipping
-    vc.slipping = stick_slip_step(x_t, pair.mu * std::max(0.0, f_n) / pair.stiffness,
-                                  (pair.friction(true) * std::max(0.0, f_n) + viscous) / pair.stiffness, u_t,
-                                  vc.slipping, vc.anchor);
     Coupling c;
     c.source = Coupling::Source::kFloor;
     c.slot = k;
     c.a = -1;
     c.b = body;
-    c.point = x;
+    c.point = p.x;
     c.normal = Vec3::UnitZ();
-    c.force = pair.stiffness * (vc.anchor - x_t) - pair.damping * u_t + Vec3(0.0, 0.0, f_n);
+    c.force = pair.stiffness * (vc.anchor - p.x_t) - pair.damping * p.u_t + Vec3(0.0, 0.0, p.f_n);
     c.k_n = c.k_t = pair.stiffness;
     c.c_n = c.c_t = pair.damping;
     c.mu = pair.friction(vc.slipping);
-    c.viscous = vc.slipping ? viscous : 0.0;
+    c.viscous = vc.slipping ? p.viscous : 0.0;
     out.push_back(c);
     ++appended;
-    if (rolling) {   // carry the stretch over to the new lowest point and its material
-      vc.anchor = Vec3(x.x(), x.y(), floor_z) + (vc.anchor - x_t);
-      vc.material = bs.rotation.transpose() * r;
-    }
+    roll_on(bs, p, floor_z, vc);
   }
   return appended;
 }
@@ -574,9 +584,7 @@ void BodyContacts::run(const Model& model, State& state, std::vector<Wrench>* wr
         continue;
       }
       Vec3 f_t = cp.stiffness * stretch - cp.damping * v_t;
-      const double limit = cp.friction(pp.slipping) * f_n + (pp.slipping ? viscous : 0.0);
-      const double f_t_norm = f_t.norm();
-      if (f_t_norm > limit) f_t *= limit / f_t_norm;
+      clamp_to_cone(cp.friction(pp.slipping) * f_n + (pp.slipping ? viscous : 0.0), f_t);
       const Vec3 f = f_n * nrm + f_t;   // N on B; -f on A, at the same point
       (*wrenches)[b].force += f;
       (*wrenches)[b].torque += rb.cross(f);

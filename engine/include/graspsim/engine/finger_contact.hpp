@@ -24,6 +24,13 @@ inline bool friction_circle_step(const Vec3& sp, double radius, Vec3& go) {
   return true;
 }
 
+// Coulomb's limit on a tangential force: scaled down onto |f_t| = limit when it is over it.
+// Floor points and body points (object_contact.cpp) take their friction force through it.
+inline void clamp_to_cone(double limit, Vec3& f_t) {
+  const double f_t_norm = f_t.norm();
+  if (f_t_norm > limit) f_t *= limit / f_t_norm;
+}
+
 // The friction circle with static and kinetic friction, for fingers and floor vertices alike.
 // Sticking, the GO moves only when the surface point SP leaves the static circle (then it slips).
 // Slipping, the GO follows SP on the kinetic circle, and the contact sticks again only when SP is
