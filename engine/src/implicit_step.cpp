@@ -61,14 +61,61 @@ Vec3 constant_force(const Coupling& c, CouplingMode mode, const Vec3& u0, const 
 
 // Adds s * J_x^T G J_y into the 6x6 block at (row, col) of the n-wide matrix, J = [I, -S(r)]:
 //   J_x^T G J_y = [[G, -G S_y], [S_x G, -S_x G S_y]].
-void add_block(double* m, int n, int row, int col, const Mat3& g, const Vec3& r_x, const Vec3& r_y, double s) {
-  const Mat3 sx = skew(r_x), sy = skew(r_y);
-  const Mat3 gs = g * sy;
-  const Mat3 blocks[2][2] = {{g, -gs}, {sx * g, -(sx * gs)}};
-  for (int bi = 0; bi < 2; ++bi)
-    for (int bj = 0; bj < 2; ++bj)
-      for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j) m[(row + 3 * bi + i) * n + col + 3 * bj + j] += s * blocks[bi][bj](i, j);
+// Two shapes of G take a shortcut (the same matrix, fewer products): isotropic, G = g I (a held
+// point whose normal and tangential laws are one), where S_x S_y = y x^T - (x . y) I; and rank
+// one, G = a b^T (a sliding point, a = g_n (n + mu t), b = n), where J_x^T G J_y = (J_x^T a)(J_y^T b)^T
+// and J^T v = (v, r x v).
+struct Response {
+  enum class Shape : std::uint8_t { kIsotropic, kRankOne, kGeneral } shape;
+  double g = 0.0;   // kIsotropic: N s/m
+  Vec3 a, b;        // kRankOne: G = a b^T
+  Mat3 full;        // every shape: G
+};
+
+void add_block(double* m, int n, int row, int col, const Response& g, const Vec3& r_x, const Vec3& r_y, double s) {
+  Eigen::Map<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>> a(m, n, n);
+  if (g.shape == Response::Shape::kIsotropic) {
+    const double sg = s * g.g;
+    const Mat3 sy = skew(r_y), sx = skew(r_x);
+    a.block<3, 3>(row, col).diagonal().array() += sg;
+    a.block<3, 3>(row, col + 3) -= sg * sy;
+    a.block<3, 3>(row + 3, col) += sg * sx;
+    Mat3 sxsy = r_y * r_x.transpose();
+    sxsy.diagonal().array() -= r_x.dot(r_y);
+    a.block<3, 3>(row + 3, col + 3) -= sg * sxsy;
+    return;
+  }
+  if (g.shape == Response::Shape::kRankOne) {
+    Eigen::Matrix<double, 6, 1> ja, jb;
+    ja << g.a, r_x.cross(g.a);
+    jb << g.b, r_y.cross(g.b);
+    a.block<6, 6>(row, col) += (s * ja) * jb.transpose();
+    return;
+  }
+  const Mat3 sx = skew(r_x);
+  const Mat3 gs = g.full * skew(r_y);
+  a.block<3, 3>(row, col) += s * g.full;
+  a.block<3, 3>(row, col + 3) -= s * gs;
+  a.block<3, 3>(row + 3, col) += s * (sx * g.full);
+  a.block<3, 3>(row + 3, col + 3) -= s * (sx * gs);
+}
+
+// The coupling's response G (response()) with its shape for add_block.
+Response response_shape(const Coupling& c, CouplingMode mode, const Vec3& slide, double h) {
+  Response r;
+  r.full = response(c, mode, slide, h);
+  const double g_n = h * c.k_n + c.c_n;
+  if (mode == CouplingMode::kSlip) {
+    r.shape = Response::Shape::kRankOne;
+    r.a = g_n * (c.normal + c.mu * slide);
+    r.b = c.normal;
+  } else if (g_n == h * c.k_t + c.c_t) {
+    r.shape = Response::Shape::kIsotropic;
+    r.g = g_n;
+  } else {
+    r.shape = Response::Shape::kGeneral;
+  }
+  return r;
 }
 
 }  // namespace
@@ -209,9 +256,9 @@ void ImplicitStep::assemble_and_solve(const Model& model, const State& state,
   for (int i : current_couplings_) {
     const Coupling& c = couplings[i];
     if (mode_[i] == CouplingMode::kOff) continue;
-    const Mat3 g = response(c, mode_[i], slide_[i], h);
+    const Response g = response_shape(c, mode_[i], slide_[i], h);
     Vec3 fc = constant_force(c, mode_[i], u0_[i], slide_[i]);
-    if (c.a < 0) fc += g * c.world_velocity;   // the world side moves on: u1 = J q1 - v_world
+    if (c.a < 0) fc += g.full * c.world_velocity;   // the world side moves on: u1 = J q1 - v_world
     const bool in_b = c.b >= 0 && island_of_[c.b] >= 0;
     const bool in_a = c.a >= 0 && island_of_[c.a] >= 0;
     const Vec3 r_b = in_b ? Vec3(c.point - state.bodies[c.b].position) : Vec3::Zero();
