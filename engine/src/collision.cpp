@@ -3,6 +3,7 @@
 #include "graspsim/engine/collision.hpp"
 
 #include "fcl_shape.hpp"
+#include "fcl_world.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -85,23 +86,16 @@ std::optional<BoxEntry> box_entry(const Vec3& h, const Vec3& a, const Vec3& b) {
 }
 
 struct CollisionWorld::Impl {
-  std::vector<std::unique_ptr<fcl::CollisionObjectd>> bodies;   // user data: body index + 1
-  fcl::DynamicAABBTreeCollisionManagerd broadphase;
+  std::shared_ptr<detail::FclWorld> world;     // the bodies' FCL objects, shared with BodyContacts
   std::shared_ptr<fcl::Capsuled> path_shape;   // the finger path, resized per query
   std::unique_ptr<fcl::CollisionObjectd> path;
   std::vector<SurfaceGeometry> surfaces;   // same order as the bodies
 };
 
-CollisionWorld::CollisionWorld(const Model& model) : impl_(std::make_unique<Impl>()) {
-  std::vector<fcl::CollisionObjectd*> objects;
-  for (std::size_t i = 0; i < model.bodies.size(); ++i) {
-    impl_->bodies.push_back(std::make_unique<fcl::CollisionObjectd>(detail::fcl_geometry(model.bodies[i].shape)));
-    impl_->bodies.back()->setUserData(reinterpret_cast<void*>(static_cast<std::intptr_t>(i + 1)));
-    objects.push_back(impl_->bodies.back().get());
-    impl_->surfaces.emplace_back(model.bodies[i].shape);
-  }
-  impl_->broadphase.registerObjects(objects);
-  impl_->broadphase.setup();
+CollisionWorld::CollisionWorld(const Model& model, std::shared_ptr<detail::FclWorld> world)
+    : impl_(std::make_unique<Impl>()) {
+  impl_->world = world ? std::move(world) : std::make_shared<detail::FclWorld>(model);
+  for (const BodyParams& body : model.bodies) impl_->surfaces.emplace_back(body.shape);
   impl_->path_shape = std::make_shared<fcl::Capsuled>(1e-6, 0.0);
   impl_->path = std::make_unique<fcl::CollisionObjectd>(impl_->path_shape);
 }
@@ -110,16 +104,7 @@ CollisionWorld::~CollisionWorld() = default;
 CollisionWorld::CollisionWorld(CollisionWorld&&) noexcept = default;
 CollisionWorld& CollisionWorld::operator=(CollisionWorld&&) noexcept = default;
 
-void CollisionWorld::update(const State& state) {
-  for (std::size_t i = 0; i < impl_->bodies.size(); ++i) {
-    fcl::Transform3d tf = fcl::Transform3d::Identity();
-    tf.linear() = state.bodies[i].rotation;
-    tf.translation() = state.bodies[i].position;
-    impl_->bodies[i]->setTransform(tf);
-    impl_->bodies[i]->computeAABB();
-  }
-  impl_->broadphase.update();
-}
+void CollisionWorld::update(const State& state) { impl_->world->update(state); }
 
 const SurfaceGeometry& CollisionWorld::surface(int body) const { return impl_->surfaces[body]; }
 
@@ -148,7 +133,7 @@ void CollisionWorld::bodies_touching_segment(const Vec3& a, const Vec3& b, doubl
   tf.translation() = 0.5 * (a + b);
   impl_->path->setTransform(tf);
   impl_->path->computeAABB();
-  impl_->broadphase.collide(impl_->path.get(), &out, add_candidate);
+  impl_->world->broadphase.collide(impl_->path.get(), &out, add_candidate);
   // The tree's order depends on how it was built: sort, so that results never do.
   std::sort(out.begin(), out.end());
 }

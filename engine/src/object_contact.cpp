@@ -12,6 +12,7 @@
 #include <fcl/narrowphase/collision_object.h>
 
 #include "fcl_shape.hpp"
+#include "fcl_world.hpp"
 #include "graspsim/engine/finger_contact.hpp"
 
 namespace graspsim {
@@ -265,15 +266,15 @@ bool add_pair(fcl::CollisionObjectd* a, fcl::CollisionObjectd* b, void* data) {
 
 struct BodyContacts::Impl {
   struct Body {
-    std::unique_ptr<fcl::CollisionObjectd> object;   // user data: body index + 1
+    fcl::CollisionObjectd* object = nullptr;         // the world's (user data: body index + 1)
     std::shared_ptr<const ConvexPolyhedron> hull;    // polyhedral shapes
     HullEdges edges;
     std::shared_ptr<const TriangleMesh> mesh;        // kMesh
     std::vector<Vec3> triangle_normals;              // 1, body frame, outward: kMesh
     double sphere_radius = 0.0;                      // m: kSphere, else 0
   };
+  std::shared_ptr<detail::FclWorld> world;           // the bodies' FCL objects, shared with CollisionWorld
   std::vector<Body> bodies;
-  fcl::DynamicAABBTreeCollisionManagerd broadphase;
   std::vector<std::pair<int, int>> candidates;       // capacity n (n - 1) / 2
   std::vector<std::uint8_t> touched;                 // per pair: a candidate this step
   ManifoldScratch scratch;
@@ -283,16 +284,7 @@ struct BodyContacts::Impl {
   fcl::CollisionRequestd request;
   fcl::CollisionResultd result;
 
-  void update(const State& state) {
-    for (std::size_t i = 0; i < bodies.size(); ++i) {
-      fcl::Transform3d tf = fcl::Transform3d::Identity();
-      tf.linear() = state.bodies[i].rotation;
-      tf.translation() = state.bodies[i].position;
-      bodies[i].object->setTransform(tf);
-      bodies[i].object->computeAABB();
-    }
-    broadphase.update();
-  }
+  void update(const State& state) { world->update(state); }
 
   // The contact points of a < b into `found`, normals from a towards b, depths > 0.
   int find(const State& state, int a, int b) {
@@ -307,7 +299,7 @@ struct BodyContacts::Impl {
     if (mesh_a && bodies[b].sphere_radius > 0.0) return sphere_mesh(a, sb.position, bodies[b].sphere_radius, false);
     if (mesh_b && bodies[a].sphere_radius > 0.0) return sphere_mesh(b, sa.position, bodies[a].sphere_radius, true);
     result.clear();
-    fcl::collide(bodies[a].object.get(), bodies[b].object.get(), request, result);
+    fcl::collide(bodies[a].object, bodies[b].object, request, result);
     const int n = std::min(static_cast<int>(result.numContacts()), kMaxPairPoints);
     const fcl::CollisionGeometryd* geometry_a = bodies[a].object->collisionGeometry().get();
     for (int i = 0; i < n; ++i) {
@@ -428,14 +420,14 @@ struct BodyContacts::Impl {
   }
 };
 
-BodyContacts::BodyContacts(const Model& model) : impl_(std::make_unique<Impl>()) {
+BodyContacts::BodyContacts(const Model& model, std::shared_ptr<detail::FclWorld> world)
+    : impl_(std::make_unique<Impl>()) {
   const int n = static_cast<int>(model.bodies.size());
-  std::vector<fcl::CollisionObjectd*> objects;
+  impl_->world = world ? std::move(world) : std::make_shared<detail::FclWorld>(model);
   for (int i = 0; i < n; ++i) {
     const Shape& shape = model.bodies[i].shape;
     Impl::Body body;
-    body.object = std::make_unique<fcl::CollisionObjectd>(detail::fcl_geometry(shape));
-    body.object->setUserData(reinterpret_cast<void*>(static_cast<std::intptr_t>(i + 1)));
+    body.object = impl_->world->bodies[static_cast<std::size_t>(i)].get();
     if (shape.kind == ShapeKind::kBox) {
       body.hull = std::make_shared<const ConvexPolyhedron>(box_polyhedron(shape.half_extents));
     } else if (shape.kind == ShapeKind::kCylinder) {
@@ -454,14 +446,11 @@ BodyContacts::BodyContacts(const Model& model) : impl_(std::make_unique<Impl>())
         body.triangle_normals.push_back(nrm.normalized());
       }
     }
-    objects.push_back(body.object.get());
     impl_->bodies.push_back(std::move(body));
   }
   for (const Impl::Body& body : impl_->bodies) {
     if (body.hull) impl_->scratch.reserve_for(body.edges, body.edges);
   }
-  impl_->broadphase.registerObjects(objects);
-  impl_->broadphase.setup();
   const std::size_t pairs = static_cast<std::size_t>(n) * static_cast<std::size_t>(n > 0 ? n - 1 : 0) / 2;
   impl_->candidates.reserve(pairs);
   impl_->touched.assign(pairs, 0);
@@ -496,7 +485,7 @@ void BodyContacts::run(const Model& model, State& state, std::vector<Wrench>* wr
   if (nb < 2) return;
   im.update(state);
   im.candidates.clear();
-  im.broadphase.collide(&im.candidates, add_pair);
+  im.world->broadphase.collide(&im.candidates, add_pair);
   // The tree's order depends on how it was built: sort, so that results never do.
   std::sort(im.candidates.begin(), im.candidates.end());
 

@@ -7,6 +7,7 @@
 #include "graspsim/engine/finger_contact.hpp"
 #include "graspsim/engine/grasp_rules.hpp"
 #include "graspsim/engine/integrate.hpp"
+#include "fcl_world.hpp"
 
 namespace graspsim {
 
@@ -29,8 +30,9 @@ Simulation::Simulation(Model model)
     : model_(validated(std::move(model))),
       divisors_(graspsim::divisors(model_.rates)),
       state_(initial_state(model_)),
-      collision_(model_),
-      body_contacts_(model_),
+      fcl_(std::make_shared<detail::FclWorld>(model_)),
+      collision_(model_, fcl_),
+      body_contacts_(model_, fcl_),
       contact_wrench_(model_.bodies.size()),
       contact_points_(model_.bodies.size(), 0),
       implicit_(model_) {

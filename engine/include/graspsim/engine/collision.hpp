@@ -42,9 +42,15 @@ struct BoxEntry {
 std::optional<BoxEntry> box_entry(const Vec3& half_extents, const Vec3& a, const Vec3& b);
 
 // FCL collision objects of the bodies, kept at the bodies' poses, in FCL's dynamic AABB tree.
+namespace detail {
+struct FclWorld;   // the bodies' FCL objects (engine/src/fcl_world.hpp)
+}
+
 class CollisionWorld {
  public:
-  explicit CollisionWorld(const Model& model);
+  // With `world`, the bodies' FCL objects are that world's, shared (Simulation shares one with
+  // BodyContacts); without, its own.
+  explicit CollisionWorld(const Model& model, std::shared_ptr<detail::FclWorld> world = nullptr);
   ~CollisionWorld();
   CollisionWorld(CollisionWorld&&) noexcept;
   CollisionWorld& operator=(CollisionWorld&&) noexcept;

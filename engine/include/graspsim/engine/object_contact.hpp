@@ -15,6 +15,10 @@
 
 namespace graspsim {
 
+namespace detail {
+struct FclWorld;   // the bodies' FCL objects (engine/src/fcl_world.hpp)
+}
+
 struct Wrench {
   Vec3 force{0.0, 0.0, 0.0};    // N, world
   Vec3 torque{0.0, 0.0, 0.0};   // N m, world, about the body's centre of mass
@@ -64,7 +68,9 @@ int floor_couplings(const Model& model, int body, BodyState& bs, double h, std::
 // (stability_warnings() says so).
 class BodyContacts {
  public:
-  explicit BodyContacts(const Model& model);
+  // With `world`, the bodies' FCL objects are that world's, shared (Simulation shares one with
+  // CollisionWorld); without, its own.
+  explicit BodyContacts(const Model& model, std::shared_ptr<detail::FclWorld> world = nullptr);
   ~BodyContacts();
   BodyContacts(BodyContacts&&) noexcept;
   BodyContacts& operator=(BodyContacts&&) noexcept;

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "graspsim/engine/collision.hpp"
@@ -69,6 +70,7 @@ class Simulation {
   Model model_;
   Divisors divisors_;
   State state_;
+  std::shared_ptr<detail::FclWorld> fcl_;   // the bodies' FCL objects, one world for both below
   CollisionWorld collision_;
   bool collision_stale_ = false;   // bodies moved since collision_ was last updated
   std::vector<int> scratch_;   // candidate bodies of a finger query
