@@ -7,48 +7,12 @@
 #include <cstdint>
 #include <vector>
 
+#include "graspsim/engine/coupling.hpp"
 #include "graspsim/engine/math.hpp"
 #include "graspsim/engine/model.hpp"
 #include "graspsim/engine/state.hpp"
 
 namespace graspsim {
-
-// One contact point as the implicit step sees it: the force it exerts at the start of the step
-// and how that force changes as the two bodies move during the step, a spring-damper about the
-// present state. With u the velocity of b's material at the point relative to a's (or to the
-// world side's velocity), and over the step the point's relative displacement taken as h u1
-// (backward Euler):
-//   f(u1) = force + C u0 - (h K + C) u1,   K = k_n n n^T + k_t (I - n n^T), C likewise.
-// Floor and body points are unilateral with Coulomb friction: after the solve a point whose
-// normal force would pull is dropped, and one whose tangential force leaves the cone slips, its
-// tangential spring and damper replaced by a sliding force mu f_n (+ viscous) (an active set,
-// ImplicitStep::solve); its sliding force follows its normal force within the solve.
-// Fingers are already held in their cone by the servo stage (mu < 0).
-struct Coupling {
-  enum class Source : std::uint8_t { kFinger, kFloor, kBody };
-  Source source = Source::kFinger;
-  int slot = -1;                   // the source's index: finger, floor point, or point of the pair
-  int a = -1;                      // body pushed by -f, or -1 for the world (floor, a finger's HIP)
-  int b = -1;                      // body pushed by +f
-  Vec3 point{0.0, 0.0, 0.0};       // m, world: where the force acts
-  Vec3 normal{0.0, 0.0, 1.0};      // 1, world, unit: the direction in which the normal force pushes b
-  Vec3 world_velocity{0.0, 0.0, 0.0};   // m/s, world: the world side's velocity over the step when
-                                        //    a = -1 (a finger's HIP, taken to go on as over the last
-                                        //    window; 0 for the floor)
-  Vec3 force{0.0, 0.0, 0.0};       // N, world, on b: at the start of the step (floor and body
-                                   //    points: the penalty law unclamped, so that it extends linearly)
-  double k_n = 0.0, c_n = 0.0;     // N/m, N s/m: along the normal
-  double k_t = 0.0, c_t = 0.0;     // N/m, N s/m: across it
-  double mu = -1.0;                // 1: friction limit |f_t| <= mu f_n + viscous; < 0 for none
-  double viscous = 0.0;            // N: viscous sliding force c |u_t| at the start (while slipping)
-};
-
-// What the solve decided for a coupling.
-enum class CouplingMode : std::uint8_t {
-  kHold,    // the whole spring-damper acts (sticking)
-  kSlip,    // normal spring-damper and a sliding force on the friction cone
-  kOff,     // the point separates: no force
-};
 
 // The solver's buffers, sized once for the model so that the step allocates nothing.
 class ImplicitStep {

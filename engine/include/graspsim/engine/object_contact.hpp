@@ -7,7 +7,7 @@
 #include <memory>
 #include <vector>
 
-#include "graspsim/engine/implicit_step.hpp"
+#include "graspsim/engine/coupling.hpp"
 #include "graspsim/engine/manifold.hpp"
 #include "graspsim/engine/math.hpp"
 #include "graspsim/engine/model.hpp"
