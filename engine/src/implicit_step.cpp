@@ -132,6 +132,14 @@ ImplicitStep::ImplicitStep(const Model& model) {
   w1_.resize(n);
 }
 
+void ImplicitStep::reserve(std::size_t couplings) {
+  mode_.reserve(couplings);
+  slide_.reserve(couplings);
+  solved_.reserve(couplings);
+  u0_.reserve(couplings);
+  current_couplings_.reserve(couplings);
+}
+
 int ImplicitStep::find(int body) {
   while (parent_[body] != body) body = parent_[body] = parent_[parent_[body]];
   return body;

@@ -54,6 +54,7 @@ Simulation::Simulation(Model model)
   floor_clear_.assign(model_.bodies.size(), 0);
   const std::size_t n = model_.bodies.size();
   couplings_.reserve(floor_points + model_.fingers.size() + kMaxPairPoints * n * (n > 0 ? n - 1 : 0) / 2);
+  implicit_.reserve(couplings_.capacity());
   awake_.resize(n);
   floor_points_.resize(n);
   rules_.resize(n);

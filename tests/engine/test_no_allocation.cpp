@@ -59,10 +59,14 @@ TEST_CASE("a simulation step allocates no heap memory after warm-up", "[schedule
 }
 
 // The same with every option on: implicit gyroscopic term (3x3 LU), two-finger torsion by gravity
-// drop (inertial and quasi-static) with a dead band, kinetic and viscous friction, spherical pads. Zero allocations.
+// drop (inertial and quasi-static) with a dead band, kinetic and viscous friction, spherical pads,
+// under both integrators (the implicit step's islands, active set and solve). Zero allocations.
 TEST_CASE("a simulation step with every option allocates no heap memory", "[schedule][realtime]") {
+  for (Integrator integrator : {Integrator::kPaper, Integrator::kImplicit})
   for (Gyroscopic gyro : {Gyroscopic::kExplicit, Gyroscopic::kImplicit}) {
+    INFO((integrator == Integrator::kPaper ? "paper" : "implicit") << " integrator");
     Model m;
+    m.integrator = integrator;
     m.gyroscopic = gyro;
     m.grasp.torsion = Torsion::kGravityDrop;
     m.grasp.critical_area = 1e-3;

@@ -19,6 +19,9 @@ class ImplicitStep {
  public:
   explicit ImplicitStep(const Model& model);
 
+  // Room for `couplings` contact points a step, so that solve() allocates nothing up to that.
+  void reserve(std::size_t couplings);
+
   // Solves (M + h C + h^2 K) q1 = M q0 + h (Q + sum J^T (force + C u0)) for the bodies'
   // velocities q1 = (v1, w1) at the end of the step, island by island, with the active set of
   // the couplings' unilateral and friction limits. `q0` holds each body's (v, w) at the start
