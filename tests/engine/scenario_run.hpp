@@ -41,31 +41,7 @@ inline void drive(const scripting::Scenario& scenario, Simulation& sim, std::int
   scripting::Snapshot view;
   const auto update_view = [&] {
     if (!scenario.uses_view()) return;
-    const State& state = sim.state();
-    view.time = sim.time();
-    view.objects.resize(model.bodies.size());
-    for (std::size_t b = 0; b < model.bodies.size(); ++b) {
-      const BodyState& bs = state.bodies[b];
-      scripting::ObjectSnapshot& o = view.objects[b];
-      o.name = model.bodies[b].name;
-      o.position = bs.position;
-      o.orientation = quat_of(bs.rotation);
-      o.velocity = bs.velocity;
-      o.angular_velocity = bs.angular_velocity;
-      o.floor_contacts = record.physics[b].floor_contacts;
-    }
-    view.fingers.resize(model.fingers.size());
-    for (std::size_t f = 0; f < model.fingers.size(); ++f) {
-      scripting::FingerSnapshot& fs = view.fingers[f];
-      fs.name = model.fingers[f].name;
-      fs.hip = record.servo[f].hip;
-      fs.force = record.servo[f].force;
-      fs.god_object = record.haptic[f].god_object;
-      const int body = state.fingers[f].body;
-      fs.touching = body >= 0 ? model.bodies[body].name : (body == kFloor ? "floor" : "");
-      fs.phase = state.fingers[f].phase;
-      fs.slip = slip[f];
-    }
+    scripting::fill_snapshot(sim, record, slip, view);
     scenario.update_view(view);
   };
   update_view();

@@ -38,45 +38,11 @@ double seconds_since(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
 }
 
-// What the scenario's expectation functions and the trajectories' view see, written into `s`
-// in place: after the first call, for the same model, it allocates nothing (names are assigned
-// over equal names, vectors keep their size; `touching` is assigned without a temporary, within
-// the room presize_snapshot gives it).
-void fill_snapshot(const Simulation& sim, const TickRecord& last, const std::vector<double>& slip,
-                   scripting::Snapshot& s) {
-  const Model& model = sim.model();
-  const State& state = sim.state();
-  s.time = sim.time();
-  s.objects.resize(model.bodies.size());
-  for (std::size_t b = 0; b < model.bodies.size(); ++b) {
-    const BodyState& bs = state.bodies[b];
-    scripting::ObjectSnapshot& o = s.objects[b];
-    o.name = model.bodies[b].name;
-    o.position = bs.position;
-    o.orientation = quat_of(bs.rotation);
-    o.velocity = bs.velocity;
-    o.angular_velocity = bs.angular_velocity;
-    o.floor_contacts = last.physics[b].floor_contacts;
-  }
-  s.fingers.resize(model.fingers.size());
-  for (std::size_t f = 0; f < model.fingers.size(); ++f) {
-    scripting::FingerSnapshot& fs = s.fingers[f];
-    fs.name = model.fingers[f].name;
-    fs.hip = last.servo[f].hip;
-    fs.force = last.servo[f].force;
-    fs.god_object = last.haptic[f].god_object;
-    const int body = state.fingers[f].body;
-    if (body >= 0) fs.touching = model.bodies[body].name;
-    else fs.touching = body == kFloor ? "floor" : "";
-    fs.phase = state.fingers[f].phase;
-    fs.slip = slip[f];
-  }
-}
 
 scripting::Snapshot snapshot(const Simulation& sim, const TickRecord& last,
                              const std::vector<double>& slip) {
   scripting::Snapshot s;
-  fill_snapshot(sim, last, slip, s);
+  scripting::fill_snapshot(sim, last, slip, s);
   return s;
 }
 
@@ -330,13 +296,13 @@ RunResult run_scenario(const scripting::Scenario& scenario, const RunOptions& op
     const bool view = scenario.uses_view();
     scripting::Snapshot view_state;
     if (view) {
-      fill_snapshot(sim, record, slip, view_state);
+      scripting::fill_snapshot(sim, record, slip, view_state);
       scenario.update_view(view_state);
     }
     if (paced) {
       // Room for every snapshot the loop will copy, so that copying allocates nothing.
       scripting::Snapshot prototype;
-      fill_snapshot(sim, record, slip, prototype);
+      scripting::fill_snapshot(sim, record, slip, prototype);
       presize_snapshot(prototype);
       due_snapshots.assign(due.size(), prototype);
       for (scripting::Snapshot& s : due_snapshots) presize_snapshot(s);
@@ -352,7 +318,7 @@ RunResult run_scenario(const scripting::Scenario& scenario, const RunOptions& op
       while (next_due < due.size() && due[next_due].first == tick) {
         const std::size_t i = due[next_due].second;
         // Paced: only the copy here; the check runs after the loop, off the real-time thread.
-        if (paced) fill_snapshot(sim, record, slip, due_snapshots[next_due]);
+        if (paced) scripting::fill_snapshot(sim, record, slip, due_snapshots[next_due]);
         else result.expectations[i] = scenario.check(i, snapshot(sim, record, slip), initial);
         ++next_due;
       }
@@ -378,7 +344,7 @@ RunResult run_scenario(const scripting::Scenario& scenario, const RunOptions& op
       if (n == 0) {
         // Before the first step no finger record exists yet: a finger is where its device is.
         for (std::size_t f = 0; f < devices.size(); ++f) record.servo[f].hip = record.haptic[f].god_object = input.fingers[f].hip;
-        if (paced) fill_snapshot(sim, record, slip, initial);
+        if (paced) scripting::fill_snapshot(sim, record, slip, initial);
         else initial = snapshot(sim, record, slip);
       }
       check_due(n);
@@ -462,7 +428,7 @@ RunResult run_scenario(const scripting::Scenario& scenario, const RunOptions& op
       }
       result.physics_ticks += record.physics_ran;
       if (view && record.physics_ran && !paced) {
-        fill_snapshot(sim, record, slip, view_state);
+        scripting::fill_snapshot(sim, record, slip, view_state);
         scenario.update_view(view_state);
       }
       if (script_feeds) {
@@ -470,7 +436,7 @@ RunResult run_scenario(const scripting::Scenario& scenario, const RunOptions& op
         // tick is done: the script thread may compute the sample that needed it.
         if (view && record.physics_ran) {
           if (scripting::Snapshot* v = script->view_slot()) {
-            fill_snapshot(sim, record, slip, *v);
+            scripting::fill_snapshot(sim, record, slip, *v);
             script->commit_view(n);
           }
         }
@@ -495,7 +461,7 @@ RunResult run_scenario(const scripting::Scenario& scenario, const RunOptions& op
       }
     }
     if (run_ticks == 0) {
-      if (paced) fill_snapshot(sim, record, slip, initial);
+      if (paced) scripting::fill_snapshot(sim, record, slip, initial);
       else initial = snapshot(sim, record, slip);
     }
     check_due(run_ticks);

@@ -12,6 +12,8 @@
 #include <vector>
 
 #include "graspsim/engine/model.hpp"
+#include "graspsim/engine/record.hpp"
+#include "graspsim/engine/simulation.hpp"
 #include "graspsim/engine/state.hpp"
 #include "graspsim/hw/device.hpp"
 #include "graspsim/hw/mapped_device.hpp"
@@ -70,6 +72,13 @@ struct Snapshot {
   std::vector<ObjectSnapshot> objects;   // Model::bodies order
   std::vector<FingerSnapshot> fingers;   // Model::fingers order
 };
+
+// What the scenario's expectation functions and the trajectories' view see, written into `s`
+// in place: after the first call, for the same model, it allocates nothing (names are assigned
+// over equal names, vectors keep their size; `touching` is assigned without a temporary, within
+// the room the run loop's presize_snapshot gives it). `slip` (m) is each finger's god-object
+// slide so far, summed over the haptic ticks.
+void fill_snapshot(const Simulation& sim, const TickRecord& last, const std::vector<double>& slip, Snapshot& s);
 
 // Perturbed waypoints (`graspsim run --jitter A --jitter-seed N`, README.md "Perturbed
 // waypoints"): every waypoint of every finger's trajectory moved by its own random offset, each
