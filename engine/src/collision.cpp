@@ -104,7 +104,7 @@ CollisionWorld::~CollisionWorld() = default;
 CollisionWorld::CollisionWorld(CollisionWorld&&) noexcept = default;
 CollisionWorld& CollisionWorld::operator=(CollisionWorld&&) noexcept = default;
 
-void CollisionWorld::update(const State& state) { impl_->world->update(state); }
+void CollisionWorld::update(const Model& model, const State& state) { impl_->world->update_fast_loops(model, state); }
 
 const SurfaceGeometry& CollisionWorld::surface(int body) const { return impl_->surfaces[body]; }
 

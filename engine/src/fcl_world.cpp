@@ -4,6 +4,7 @@
 #include <cstdint>
 
 #include "fcl_shape.hpp"
+#include "graspsim/engine/local_model.hpp"
 
 namespace graspsim::detail {
 
@@ -18,13 +19,27 @@ FclWorld::FclWorld(const Model& model) {
   broadphase.setup();
 }
 
+namespace {
+
+void place(fcl::CollisionObjectd& object, const Mat3& rotation, const Vec3& position) {
+  fcl::Transform3d tf = fcl::Transform3d::Identity();
+  tf.linear() = rotation;
+  tf.translation() = position;
+  object.setTransform(tf);
+  object.computeAABB();
+}
+
+}  // namespace
+
 void FclWorld::update(const State& state) {
+  for (std::size_t i = 0; i < bodies.size(); ++i) place(*bodies[i], state.bodies[i].rotation, state.bodies[i].position);
+  broadphase.update();
+}
+
+void FclWorld::update_fast_loops(const Model& model, const State& state) {
   for (std::size_t i = 0; i < bodies.size(); ++i) {
-    fcl::Transform3d tf = fcl::Transform3d::Identity();
-    tf.linear() = state.bodies[i].rotation;
-    tf.translation() = state.bodies[i].position;
-    bodies[i]->setTransform(tf);
-    bodies[i]->computeAABB();
+    const Pose pose = fast_loop_pose(model, state.bodies[i], state.tick);
+    place(*bodies[i], pose.rotation, pose.position);
   }
   broadphase.update();
 }

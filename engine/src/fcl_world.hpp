@@ -20,6 +20,8 @@ struct FclWorld {
   // Moves the objects to the bodies' poses in `state` and refits the tree. Queries sort what
   // they find, so results never depend on the tree's shape, which follows its update history.
   void update(const State& state);
+  // The same with the poses the fast loops see at state.tick (local_model.hpp).
+  void update_fast_loops(const Model& model, const State& state);
 
   std::vector<std::unique_ptr<fcl::CollisionObjectd>> bodies;   // user data: body index + 1
   fcl::DynamicAABBTreeCollisionManagerd broadphase;

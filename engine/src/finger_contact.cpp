@@ -4,18 +4,23 @@
 #include <algorithm>
 #include <cmath>
 
+#include "graspsim/engine/local_model.hpp"
+
 namespace graspsim {
 namespace {
 
-// Pose of the frame a contact lives in: a body's, or the world's for the floor.
+// Pose of the frame a contact lives in: a body's as the fast loops see it now (local_model.hpp),
+// or the world's for the floor.
 struct Frame {
   Mat3 R;   // 1: frame to world
   Vec3 p;   // m: frame origin in world
+  Vec3 v;   // m/s, world: the origin's velocity
 };
 
-Frame contact_frame(const State& state, int body) {
-  if (body >= 0) return Frame{state.bodies[body].rotation, state.bodies[body].position};
-  return Frame{Mat3::Identity(), Vec3::Zero()};
+Frame contact_frame(const Model& model, const State& state, int body) {
+  if (body < 0) return Frame{Mat3::Identity(), Vec3::Zero(), Vec3::Zero()};
+  const Pose pose = fast_loop_pose(model, state.bodies[body], state.tick);
+  return Frame{pose.rotation, pose.position, pose.velocity};
 }
 
 
@@ -71,9 +76,11 @@ void finger_haptic_step(const Model& model, const State& state, const CollisionW
     for (int b : scratch) {
       const BodyState& bs = state.bodies[b];
       const bool moved = fs.has_last_haptic && bs.stepped_at >= last_haptic;
+      const Pose then = fast_loop_pose(model, bs, last_haptic);
+      const Pose now = fast_loop_pose(model, bs, state.tick);
       const Vec3 a_b = moved ? Vec3(bs.rotation_before_step.transpose() * (a - bs.position_before_step))
-                             : Vec3(bs.rotation.transpose() * (a - bs.position));
-      const Vec3 hip_b = bs.rotation.transpose() * (hip - bs.position);
+                             : Vec3(then.rotation.transpose() * (a - then.position));
+      const Vec3 hip_b = now.rotation.transpose() * (hip - now.position);
       if (const auto e = surface_entry(collision.surface(b), r, a_b, hip_b); e && e->t < best_t) {
         best_t = e->t;
         fs.body = b;
@@ -103,7 +110,7 @@ void finger_haptic_step(const Model& model, const State& state, const CollisionW
   }
 
   if (track) {
-    const Frame fr = contact_frame(state, fs.body);
+    const Frame fr = contact_frame(model, state, fs.body);
     const Vec3 hip_c = fr.R.transpose() * (hip - fr.p);   // HIP in the contact frame
     // Step 1: the surface point SP (the frictionless god-object), the contact normal and the
     // depth, tracked from the contact's features: on a box the entered face, on other shapes the
@@ -139,7 +146,7 @@ void finger_haptic_step(const Model& model, const State& state, const CollisionW
             : Vec3::Zero();
         if (fs.body >= 0) {
           const BodyState& bs = state.bodies[fs.body];
-          v_rel -= bs.velocity + bs.angular_velocity.cross(go_w - bs.position);
+          v_rel -= fr.v + bs.angular_velocity.cross(go_w - fr.p);
         }
         v_rel_t = v_rel - v_rel.dot(n_w) * n_w;
       }
@@ -223,7 +230,7 @@ Vec3 finger_force(const Model& model, const State& state, int finger, const Vec3
     contact_point = hip;
     return Vec3::Zero();
   }
-  const Frame fr = contact_frame(state, fs.body);
+  const Frame fr = contact_frame(model, state, fs.body);
   const Vec3 go_world = fr.R * fs.god_object + fr.p;
   const Vec3 n_w = fr.R * fs.normal;   // the contact normal at SP at the last haptic tick
   contact_point = go_world - model.fingers[finger].radius * n_w;   // on the surface
@@ -238,7 +245,7 @@ Vec3 finger_force(const Model& model, const State& state, int finger, const Vec3
     Vec3 v_go = Vec3::Zero();
     if (fs.body >= 0) {
       const BodyState& bs = state.bodies[fs.body];
-      v_go = bs.velocity + bs.angular_velocity.cross(contact_point - bs.position);
+      v_go = fr.v + bs.angular_velocity.cross(contact_point - fr.p);
     }
     force += c * (v_go - v_hip);
   }

@@ -42,20 +42,21 @@ void lu_solve(double* a, double* b, int n) {
 // velocity at the end of the step. While sliding along unit t (tangential, the way the held
 // spring pulled) the tangential force is mu times the normal one: G = g_n (n + mu t) n^T.
 Mat3 response(const Coupling& c, CouplingMode mode, const Vec3& slide, double h) {
-  const double g_n = h * c.k_n + c.c_n;
+  const double reach = h + c.lead;   // s: the time the springs see the end velocity over
+  const double g_n = reach * c.k_n + c.c_n;
   if (mode == CouplingMode::kSlip) return g_n * (c.normal + c.mu * slide) * c.normal.transpose();
   const Mat3 nn = c.normal * c.normal.transpose();
-  const double g_t = h * c.k_t + c.c_t;
+  const double g_t = reach * c.k_t + c.c_t;
   return g_n * nn + g_t * (Mat3::Identity() - nn);
 }
 
-// The constant part of the force, force + C u0, in its mode; while sliding along t the
+// The constant part of the force, force + (C + lead K) u0, in its mode; while sliding along t the
 // tangential part is mu times the normal part, plus the viscous force.
 Vec3 constant_force(const Coupling& c, CouplingMode mode, const Vec3& u0, const Vec3& slide) {
   const Vec3& n = c.normal;
-  const double normal = n.dot(c.force) + c.c_n * n.dot(u0);   // N
+  const double normal = n.dot(c.force) + (c.c_n + c.lead * c.k_n) * n.dot(u0);   // N
   if (mode == CouplingMode::kSlip) return normal * (n + c.mu * slide) + c.viscous * slide;
-  const Vec3 tangential = c.force - n.dot(c.force) * n + c.c_t * (u0 - n.dot(u0) * n);
+  const Vec3 tangential = c.force - n.dot(c.force) * n + (c.c_t + c.lead * c.k_t) * (u0 - n.dot(u0) * n);
   return normal * n + tangential;
 }
 
@@ -104,12 +105,13 @@ void add_block(double* m, int n, int row, int col, const Response& g, const Vec3
 Response response_shape(const Coupling& c, CouplingMode mode, const Vec3& slide, double h) {
   Response r;
   r.full = response(c, mode, slide, h);
-  const double g_n = h * c.k_n + c.c_n;
+  const double reach = h + c.lead;   // s
+  const double g_n = reach * c.k_n + c.c_n;
   if (mode == CouplingMode::kSlip) {
     r.shape = Response::Shape::kRankOne;
     r.a = g_n * (c.normal + c.mu * slide);
     r.b = c.normal;
-  } else if (g_n == h * c.k_t + c.c_t) {
+  } else if (g_n == reach * c.k_t + c.c_t) {
     r.shape = Response::Shape::kIsotropic;
     r.g = g_n;
   } else {

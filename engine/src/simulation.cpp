@@ -7,6 +7,7 @@
 #include "graspsim/engine/finger_contact.hpp"
 #include "graspsim/engine/grasp_rules.hpp"
 #include "graspsim/engine/integrate.hpp"
+#include "graspsim/engine/local_model.hpp"
 #include "fcl_world.hpp"
 
 namespace graspsim {
@@ -36,7 +37,7 @@ Simulation::Simulation(Model model)
       contact_wrench_(model_.bodies.size()),
       contact_points_(model_.bodies.size(), 0),
       implicit_(model_) {
-  collision_.update(state_);
+  collision_.update(model_, state_);
   scratch_.reserve(model_.bodies.size());
   // How far below its centre of mass a body can reach the floor: its farthest floor point (a
   // rolling point is at radius r from a centre point; the capsule's at L + r), with 1e-9 to spare.
@@ -85,11 +86,12 @@ void Simulation::step(const Input& input, TickRecord& record) {
 void Simulation::haptic_stage(const Input& input, TickRecord& record) {
   // The finger broadphase is only asked by free fingers (a finger in contact tracks its own
   // body's surface): it follows the bodies here, when one will ask, not at every physics step.
-  // Same poses, same answers (the candidates are sorted), so this changes no result.
-  if (collision_stale_) {
+  // Same poses, same answers (the candidates are sorted), so this changes no result. Under the
+  // local model the bodies move at every tick, so it follows them at every haptic tick.
+  if (collision_stale_ || uses_local_model(model_)) {
     for (const FingerState& fs : state_.fingers) {
       if (fs.phase == ContactPhase::kFree) {
-        collision_.update(state_);
+        collision_.update(model_, state_);
         collision_stale_ = false;
         break;
       }
@@ -117,7 +119,7 @@ void Simulation::servo_stage(const Input& input, TickRecord& record) {
     if (b >= 0) {
       BodyState& bs = state_.bodies[b];
       bs.window_force -= force;
-      bs.window_torque += (contact_point - bs.position).cross(-force);
+      bs.window_torque += (contact_point - fast_loop_pose(model_, bs, state_.tick).position).cross(-force);
       if (model_.integrator == Integrator::kImplicit) state_.fingers[f].window_force -= force;
     }
   }

@@ -7,6 +7,7 @@
 #include "graspsim/engine/finger_contact.hpp"
 #include "graspsim/engine/grasp_rules.hpp"
 #include "graspsim/engine/integrate.hpp"
+#include "graspsim/engine/local_model.hpp"
 #include "graspsim/engine/simulation.hpp"
 
 namespace graspsim {
@@ -35,14 +36,21 @@ void Simulation::implicit_contacts(const Input& input) {
     const BodyState& bs = state_.bodies[fs.body];
     const double k = finger_contact_pair(model_, static_cast<int>(f), fs.body).stiffness;   // N/m
     const double c = model_.fingers[f].damping;                                          // N s/m
+    // The window's forces were measured on the body as the fast loops saw it (local_model.hpp),
+    // `lead` ahead of this step's pose on average: the spring's force at the step's pose is the
+    // window's plus k lead u0, and the next window, seen `lead` ahead of the end pose, feels the
+    // end velocity over h + lead (Coupling; derivation in engine/README.md, "The local model").
+    const Pose seen = fast_loop_pose(model_, bs, state_.tick);
+    const Vec3 point = bs.rotation * (seen.rotation.transpose() * (finger_point_[f] - seen.position)) + bs.position;
     Coupling cp;
     cp.source = Coupling::Source::kFinger;
     cp.slot = static_cast<int>(f);
     cp.b = fs.body;
-    cp.point = finger_point_[f];
+    cp.point = point;
     cp.normal = -(bs.rotation * fs.normal);   // into the body
     cp.world_velocity = hip_velocity;
     cp.force = window;
+    cp.lead = fast_loop_lead(model_);
     cp.k_n = cp.k_t = k;
     cp.c_n = cp.c_t = c;
     cp.mu = fs.friction_mu;

@@ -216,7 +216,7 @@ TEST_CASE("collision world reports the bodies a finger path touches", "[collisio
   m.bodies.push_back(graspsim::test::make_box("a", 1.0, Vec3(0.1, 0.1, 0.1), Vec3(0.0, 0.0, 0.0)));
   m.bodies.push_back(graspsim::test::make_box("b", 1.0, Vec3(0.1, 0.1, 0.1), Vec3(1.0, 0.0, 0.0)));
   CollisionWorld world(m);
-  world.update(initial_state(m));
+  world.update(m, initial_state(m));
   std::vector<int> out;
   world.bodies_touching_segment(Vec3(-0.5, 0.0, 0.0), Vec3(1.5, 0.0, 0.0), 0.0, out);
   CHECK(out == std::vector<int>{0, 1});

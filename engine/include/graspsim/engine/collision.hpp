@@ -55,8 +55,9 @@ class CollisionWorld {
   CollisionWorld(CollisionWorld&&) noexcept;
   CollisionWorld& operator=(CollisionWorld&&) noexcept;
 
-  // Moves the FCL objects to the bodies' current poses.
-  void update(const State& state);
+  // Moves the FCL objects to the bodies' poses as the fast loops see them at state.tick
+  // (local_model.hpp: the physics poses under the paper's integrator).
+  void update(const Model& model, const State& state);
 
   // Indices of the bodies whose bounding boxes the segment a -> b (world), swept by a sphere of
   // `radius` (m), touches, ascending, written into `out` (cleared first; no allocation once its

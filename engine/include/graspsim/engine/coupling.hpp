@@ -14,7 +14,11 @@ namespace graspsim {
 // present state. With u the velocity of b's material at the point relative to a's (or to the
 // world side's velocity), and over the step the point's relative displacement taken as h u1
 // (backward Euler):
-//   f(u1) = force + C u0 - (h K + C) u1,   K = k_n n n^T + k_t (I - n n^T), C likewise.
+//   f(u1) = force + (C + lead K) u0 - ((h + lead) K + C) u1,   K = k_n n n^T + k_t (I - n n^T),
+// C likewise. `lead` is zero but for a finger seen through the local model (local_model.hpp):
+// its force is the mean over a window whose poses ran ahead of the step's start by `lead` on
+// average (force - lead K u0 at the start pose), and the next window's will run as far ahead of
+// the end pose (force - (h + lead) K u1 there).
 // Floor and body points are unilateral with Coulomb friction: after the solve a point whose
 // normal force would pull is dropped, and one whose tangential force leaves the cone slips, its
 // tangential spring and damper replaced by a sliding force mu f_n (+ viscous) (an active set,
@@ -35,6 +39,7 @@ struct Coupling {
                                    //    points: the penalty law unclamped, so that it extends linearly)
   double k_n = 0.0, c_n = 0.0;     // N/m, N s/m: along the normal
   double k_t = 0.0, c_t = 0.0;     // N/m, N s/m: across it
+  double lead = 0.0;               // s: how far ahead of the step's poses the force is measured
   double mu = -1.0;                // 1: friction limit |f_t| <= mu f_n + viscous; < 0 for none
   double viscous = 0.0;            // N: viscous sliding force c |u_t| at the start (while slipping)
 };

@@ -156,6 +156,8 @@ struct Model {
   Rates rates;
   SleepParams sleep;
   Integrator integrator = Integrator::kPaper;
+  bool local_model = false;   // under kImplicit: the fast loops see each body move on between
+                              // physics steps (local_model.hpp); else they see its last pose
   Gyroscopic gyroscopic = Gyroscopic::kNeglect;
   GraspParams grasp;
   Vec3 gravity{0.0, 0.0, -9.81};   // m/s^2
