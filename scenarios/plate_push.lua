@@ -25,6 +25,7 @@ if s > t2 then s = (mass * g + k * (t2 - hip_low) + 4 * k_floor * t2) / (8 * k_f
 local below_plate = false   -- the HIP has been under the plate's bottom face
 local worst_go = math.huge  -- m: lowest GO height over the plate's top face, at physics ticks
 local last_time, h = 0, nil -- s: the view's time at the last physics tick, and the physics period
+local seen, latest = nil, nil -- the plate's {x, y, z, vx, vy, vz} in the view before the latest, and in it
 
 return {
   name = "plate_push",
@@ -39,12 +40,21 @@ return {
   fingers = {
     { name = "finger", stiffness = k, damping = 5, max_force = 100,
       trajectory = function(t, sim)
-        if sim ~= nil and sim.time ~= last_time then h, last_time = sim.time - last_time, sim.time end
-        if sim ~= nil and h ~= nil and sim.fingers.finger.touching == "plate" then
+        if sim ~= nil and sim.time ~= last_time then
+          h, last_time = sim.time - last_time, sim.time
+          local p, v = sim.objects.plate.position, sim.objects.plate.velocity
+          seen, latest = latest, { p[1], p[2], p[3], v[1], v[2], v[3] }
+        end
+        if sim ~= nil and h ~= nil and sim.fingers.finger.touching == "plate" and (seen or not sim.local_model) then
           -- The view's GO (world) is the haptic tick's, from before the physics step of the same
           -- tick moved the plate by v h (symplectic Euler): compare it with the plate where it was.
+          -- Under the local model that tick saw the plate a physics period on from the view
+          -- before, at its velocity then: seen + h v_seen.
           local p, go, v = sim.objects.plate, sim.fingers.finger.god_object, sim.objects.plate.velocity
           local c = { p.position[1] - v[1] * h, p.position[2] - v[2] * h, p.position[3] - v[3] * h }
+          if sim.local_model then
+            c = { seen[1] + seen[4] * h, seen[2] + seen[5] * h, seen[3] + seen[6] * h }
+          end
           -- the GO's height over the top face, along the plate's normal (its body z; the central
           -- push keeps it level, so the step's turn is left out)
           local up = (go[1] - c[1]) * p.rotation[1][3] + (go[2] - c[2]) * p.rotation[2][3]

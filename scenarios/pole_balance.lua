@@ -48,8 +48,15 @@ local function finger(t, sim)
   -- lean toward +x is the axis' x component (rotation about +y); toward +y, its y (about -x)
   local ux = k1 * R[1][3] + k2 * w[2] + k3 * (x[1] - centre[1]) + k4 * v[1]
   local uy = k1 * R[2][3] - k2 * w[1] + k3 * (x[2] - centre[2]) + k4 * v[2]
-  -- the god-object rides at the bottom face centre: position - L/2 axis
+  -- the god-object rides at the bottom face centre: position - L/2 axis; under the local model
+  -- the finger feels the pole move on from the view at its velocities, so the centre is where
+  -- the view puts it plus (t - sim.time) times the bottom's velocity, v + w x (-L/2 axis)
   local gx, gy = x[1] - L / 2 * R[1][3], x[2] - L / 2 * R[2][3]
+  if sim.local_model then
+    local age = t - sim.time
+    gx = gx + age * (v[1] - L / 2 * (w[2] * R[3][3] - w[3] * R[2][3]))
+    gy = gy + age * (v[2] - L / 2 * (w[3] * R[1][3] - w[1] * R[3][3]))
+  end
   return gx + gain * m * ux / k, gy + gain * m * uy / k, base[3] + d0
 end
 

@@ -318,6 +318,9 @@ const char* phase_name(ContactPhase phase) {
 // Writes snapshot `s` into the table at absolute index `table`.
 void write_state(lua_State* state, int table, const Snapshot& s, Tables& tables) {
   set_number(state, table, "time", s.time);
+  lua_pushliteral(state, "local_model");
+  lua_pushboolean(state, s.local_model ? 1 : 0);
+  lua_rawset(state, table);
   open_field(state, table, "objects", 0, static_cast<int>(s.objects.size()), tables);
   const int objects = lua_gettop(state);
   for (const ObjectSnapshot& o : s.objects) {

@@ -491,7 +491,7 @@ bool is_named_array(TableKind kind) {
 
 const std::vector<std::string>& fields_of(TableKind kind) {
   static const std::vector<std::string> kRoot = {
-      "name", "description", "duration", "seed", "rates", "gravity", "integrator", "stability",
+      "name", "description", "duration", "seed", "rates", "gravity", "integrator", "local_model", "stability",
       "gyroscopic", "grasp", "floor", "sleep", "objects", "fingers", "expect"};
   static const std::vector<std::string> kGrasp = {"torsion", "critical_area", "gimbal_finger", "dead_band",
                                                       "torsional_damping"};
@@ -620,6 +620,13 @@ ScenarioParts convert_scenario(const LuaValue& root, const std::string& default_
   if (const LuaValue* i = r.get("integrator")) {
     const std::string name = choice(*i, r.at("integrator"), {"paper", "implicit"}, "integrator");
     s.model.integrator = name == "paper" ? Integrator::kPaper : Integrator::kImplicit;
+  }
+  if (const LuaValue* lm = r.get("local_model")) {
+    if (lm->type != LuaValue::Type::kBoolean) fail(r.at("local_model"), "expected true or false, got " + lm->type_name());
+    s.model.local_model = lm->boolean;
+    if (s.model.local_model && s.model.integrator != Integrator::kImplicit) {
+      fail(r.at("local_model"), "needs integrator = \"implicit\" (the paper's step has no local model)");
+    }
   }
   if (const LuaValue* st = r.get("stability")) {
     s.refuse_unstable = choice(*st, r.at("stability"), {"warn", "refuse"}, "stability choice") == "refuse";

@@ -1,4 +1,5 @@
 // The view a scenario's scripts see, filled from the simulation.
+#include "graspsim/engine/local_model.hpp"
 #include "graspsim/engine/simulation.hpp"
 #include "graspsim/scripting/scenario.hpp"
 
@@ -8,6 +9,7 @@ void fill_snapshot(const Simulation& sim, const TickRecord& last, const std::vec
   const Model& model = sim.model();
   const State& state = sim.state();
   s.time = sim.time();
+  s.local_model = uses_local_model(model);
   s.objects.resize(model.bodies.size());
   for (std::size_t b = 0; b < model.bodies.size(); ++b) {
     const BodyState& bs = state.bodies[b];

@@ -176,6 +176,7 @@ RunResult run_scenario(const scripting::Scenario& scenario, const RunOptions& op
   writer.set_attribute("scenario_source_hash", source_hash(scenario.source()));
   writer.set_attribute("overrides", join_lines(options.overrides));
   writer.set_attribute("integrator", std::string(model.integrator == Integrator::kPaper ? "paper" : "implicit"));
+  writer.set_attribute("local_model", static_cast<std::int64_t>(model.local_model ? 1 : 0));
   writer.set_attribute("parameters", join_lines(scenario.parameters()));
   // Perturbed waypoints (README.md "Perturbed waypoints"): a replay loads the scenario with the
   // same jitter; the offsets themselves, to read and to check the generator against.

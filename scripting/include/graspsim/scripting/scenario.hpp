@@ -69,6 +69,8 @@ struct FingerSnapshot {
 };
 struct Snapshot {
   double time = 0.0;   // s
+  bool local_model = false;   // the fast loops see each body move on from this pose at its
+                              // velocities (engine local_model.hpp; integrator = "implicit")
   std::vector<ObjectSnapshot> objects;   // Model::bodies order
   std::vector<FingerSnapshot> fingers;   // Model::fingers order
 };
