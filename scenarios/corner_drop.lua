@@ -8,9 +8,11 @@
 -- 50 Hz), so 1e5 is stable: the cube lands, rotates down onto a face and rests m g / (4 k) = 12 um
 -- deep. It keeps a period-2 tangential cycle: its centre alternates by 2.4 um between two points
 -- every physics step (1.7 mm/s), the floor's friction anchors slipping in a friction circle only
--- mu m g / (4 k) = 7 um wide; no creep (found by this scenario; engine/README.md, Limits). Try
--- --set stiffness=3e6: the run diverges (the engine stops it and names the body), as
--- the bench's detector says; or --set rates.physics=50 and it diverges too.
+-- mu m g / (4 k) = 7 um wide; no creep (found by this scenario; engine/README.md, Limits). That
+-- is the paper's step (--set integrator=paper); the implicit one, the default, rests the cube at
+-- any stiffness. Try --set integrator=paper --set stiffness=3e6: the explicit step blows up, and
+-- the energy watch (engine/energy.hpp) stops the run at the physics tick the cube's energy passes
+-- its bound, naming the body, with exit 2 and the trace kept; --set rates.physics=50 too.
 
 local mass = 0.5                                -- kg
 local half = 0.05                               -- m

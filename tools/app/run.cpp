@@ -16,6 +16,7 @@
 #include "app/script_thread.hpp"
 #include "app/stability_watch.hpp"
 
+#include "graspsim/engine/energy.hpp"
 #include "graspsim/engine/simulation.hpp"
 #include "graspsim/engine/state_hash.hpp"
 #include "graspsim/hw/mapped_device.hpp"
@@ -31,6 +32,21 @@
 
 namespace graspsim::app {
 namespace {
+
+// What the energy watch found, for the user: which bodies, how much, since when, and what to do.
+std::string energy_gain_message(const Model& model, const EnergyGain& g, double t, std::int64_t tick) {
+  std::ostringstream msg;
+  msg << "objects[" << g.body + 1 << "] '" << model.bodies[g.body].name << "'";
+  if (g.bodies > 1) msg << " and the " << g.bodies - 1 << " bodies touching it";
+  msg << " gained " << g.energy - g.reference << " J with no finger on " << (g.bodies > 1 ? "them" : "it") << ", from " << g.reference
+      << " J at t = " << g.since << " s to " << g.energy << " J at t = " << t << " s (tick " << tick
+      << "; allowed " << g.bound << " J): the integration is unstable";
+  if (model.integrator == Integrator::kPaper) {
+    msg << " (the paper's explicit step at rates.physics = " << model.rates.physics
+        << " Hz; raise the rate, soften the contact, or use integrator = \"implicit\")";
+  }
+  return msg.str();
+}
 
 using Clock = std::chrono::steady_clock;
 
@@ -225,6 +241,8 @@ RunResult run_scenario(const scripting::Scenario& scenario, const RunOptions& op
   stability.before_run();
   writer.set_attribute("warnings", stability.text());
   writer.set_attribute("force_ramp", options.force_ramp);
+
+  EnergyWatch energy(model);   // a blow-up of bodies nothing powers stops the run (energy.hpp)
 
   const auto start = Clock::now();
   std::optional<Simulation> sim_holder;
@@ -422,7 +440,12 @@ RunResult run_scenario(const scripting::Scenario& scenario, const RunOptions& op
                "masses at rates.physics = " << model.rates.physics << " Hz";
         throw std::runtime_error(msg.str());
       }
-      if (record.physics_ran) stability.after_physics(sim.state(), n, t);   // throws to refuse
+      if (record.physics_ran) {
+        stability.after_physics(sim.state(), n, t);   // throws to refuse
+        if (const std::optional<EnergyGain> gain = energy.after_physics(sim.state(), t)) {
+          throw std::runtime_error(energy_gain_message(model, *gain, t, n));
+        }
+      }
       if (record.haptic_ran) {
         ++result.haptic_ticks;
         for (std::size_t f = 0; f < slip.size(); ++f) slip[f] += record.haptic[f].slip;
