@@ -18,6 +18,8 @@
 #include <type_traits>
 #include <vector>
 
+#include <sys/resource.h>
+
 #include "disk_reserve.hpp"
 #include "h5.hpp"
 
@@ -615,7 +617,9 @@ struct TraceWriter::Impl {
   // Ordered by name, so the file's layout does not depend on first use.
   std::map<std::string, std::unique_ptr<TraceTable>> tables;
   DiskReserve reserve;   // given back at close(), for what closing writes
+  hsize_t size_limit = 0;   // bytes: the process's file size limit (RLIMIT_FSIZE), 0 for none
   bool closed = false;
+  bool marked = false;   // close() wrote the final status
 
   std::string context() const { return "trace " + quoted(path); }
   void require_open() const {
@@ -702,6 +706,17 @@ void TraceWriter::Impl::run(const Job& job) {
     }
   } give_back{state, table, block};
   if (state.worker.failure()) return;   // after a failure, later rows are not written
+  if (size_limit > 0) {
+    // A write past RLIMIT_FSIZE fails with EFBIG, and then closing could not write either: stop
+    // short of it by the reserve's size, as a full disk stops the writer with the reserve held.
+    hsize_t size = 0;
+    const hsize_t bytes = static_cast<hsize_t>(block.count * table.packed_width);
+    if (H5Fget_filesize(file.get(), &size) >= 0 && size + bytes + options.reserve_bytes > size_limit) {
+      throw TraceError(context() + ", table " + quoted("/" + table.name) + ": cannot append rows: the file would pass " +
+                       std::to_string(size_limit) + " bytes, this process's file size limit (ulimit -f), less " +
+                       std::to_string(options.reserve_bytes) + " kept for closing it");
+    }
+  }
   table.write_block(block);
 }
 
@@ -743,6 +758,9 @@ TraceWriter::TraceWriter(const std::string& path, TraceOptions options)
   release.impl = nullptr;
   const std::string directory = std::filesystem::path(path).parent_path().string();
   impl_->reserve = DiskReserve(directory.empty() ? "." : directory, options.reserve_bytes);
+  struct rlimit limit{};
+  if (getrlimit(RLIMIT_FSIZE, &limit) == 0 && limit.rlim_cur != RLIM_INFINITY)
+    impl_->size_limit = static_cast<hsize_t>(limit.rlim_cur);
 }
 
 TraceWriter::~TraceWriter() {
@@ -917,6 +935,7 @@ void TraceWriter::close(const std::string& status) {
     root.reset();
     if (file.close() < 0) throw TraceError(w.context() + ": cannot close: " + h5::last_error());
     marked = true;
+    w.marked = true;
   } catch (const TraceError& e) {
     if (failure.empty()) failure = e.what();
   }
@@ -950,6 +969,8 @@ std::string TraceWriter::Impl::cut_to_last_flush(hid_t file_id) {
 }
 
 bool TraceWriter::is_closed() const { return impl_->closed; }
+
+bool TraceWriter::marked() const { return impl_->marked; }
 
 const std::string& TraceWriter::path() const { return impl_->path; }
 

@@ -143,6 +143,9 @@ class TraceWriter {
   // be written, the message says so (the file then says "running": `graspsim repair`).
   void close(const std::string& status);
   bool is_closed() const;
+  // Closed with its final status in the file ("complete" or "error: ..."): a file that may
+  // replace an earlier one. False while open, and when close() could not write the status.
+  bool marked() const;
   const std::string& path() const;
 
  private:
