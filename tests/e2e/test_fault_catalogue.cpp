@@ -192,7 +192,8 @@ TEST_CASE("catalogue: a file-size limit ends the run with exit 3 and a marked tr
 // ---------------------------------------------------------------------------------------------
 // Items 2 and 15: two runs, one output. While run A writes out.h5 (held stopped mid-run), run B
 // on the same output exits 2 with "another graspsim run is writing it" and touches nothing: the
-// earlier out.h5 is byte-identical, and A, let go and ended by SIGTERM, finishes a trace whose
+// earlier out.h5 is byte-identical; `graspsim repair out.h5.partial` exits 2 and leaves A's
+// partial trace byte-identical; and A, let go and ended by SIGTERM, finishes a trace whose
 // ticks run 0, 1, 2, ... to where it stopped (B truncated none of it), status "error: interrupted
 // by SIGTERM", exit 143.
 TEST_CASE("catalogue: a second run on an output being written refuses and touches nothing", "[fault_catalogue][lock]") {
@@ -209,6 +210,13 @@ TEST_CASE("catalogue: a second run on an output being written refuses and touche
   CHECK_THAT(b.output, Catch::Contains("--out 'out.h5': another graspsim run is writing it") &&
                            Catch::Contains("'out.h5.partial' is locked"));
   CHECK(file_bytes(dir + "/out.h5") == earlier);
+  // Nor may the partial trace be "repaired" while the run holds it.
+  const auto partial = file_bytes(dir + "/out.h5.partial");
+  const Outcome repair = cli_in(dir, "repair out.h5.partial");
+  INFO(repair.output);
+  CHECK(repair.status == 2);
+  CHECK_THAT(repair.output, Catch::Contains("is being written by a graspsim run (it is locked)"));
+  CHECK(file_bytes(dir + "/out.h5.partial") == partial);
   REQUIRE(kill(a.child.pid(), SIGCONT) == 0);
   REQUIRE(kill(a.child.pid(), SIGTERM) == 0);
   const Ended e = a.child.wait();

@@ -58,6 +58,17 @@ void refuse_input_as_output(const std::string& out, const std::vector<InputFile>
   }
 }
 
+bool locked_by_a_run(const std::string& path) {
+  const int fd = open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0) return false;
+  struct flock lock{};
+  lock.l_type = F_WRLCK;
+  lock.l_whence = SEEK_SET;
+  const bool locked = fcntl(fd, F_OFD_GETLK, &lock) == 0 && lock.l_type != F_UNLCK;
+  ::close(fd);
+  return locked;
+}
+
 OutputClaim::OutputClaim(const std::string& out) : out_(out), partial_(partial_name(out)) {
   struct stat st{};
   if (stat(out.c_str(), &st) == 0 && S_ISDIR(st.st_mode))

@@ -41,6 +41,10 @@ std::string partial_name(const std::string& out);
 // hard link to an input is refused too).
 void refuse_input_as_output(const std::string& out, const std::vector<InputFile>& inputs);
 
+// True when a run holds the lock of an OutputClaim on `path` (its partial trace is being
+// written): such a file must not be repaired or written by anyone else.
+bool locked_by_a_run(const std::string& path);
+
 // A run's claim on its output path. The constructor creates `<out>.partial` and takes an
 // exclusive open-file-description lock (fcntl F_OFD_SETLK, which HDF5's own flock() locks
 // do not interfere with) on it, held until the claim ends. Throws OutputError, having changed
