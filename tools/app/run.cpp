@@ -9,6 +9,7 @@
 #include <csignal>
 #include <cstdio>
 #include <cstring>
+#include <exception>
 #include <memory>
 #include <numeric>
 #include <optional>
@@ -171,6 +172,22 @@ RunResult run_scenario(const scripting::Scenario& scenario, const RunOptions& op
   // Without a trace (the logging benchmark's baseline) every attribute and row is skipped.
   std::optional<recordings::TraceWriter> writer_holder;
   std::optional<OutputClaim> claim;   // the output path, locked; the trace is written to its partial name
+  // A failure that escapes before the loop (the file or its first attributes cannot be
+  // written: a full disk) leaves a partial trace without a tick: it is closed and removed, and
+  // the output path is as it was.
+  struct AbandonOnThrow {
+    std::optional<recordings::TraceWriter>& writer;
+    std::optional<OutputClaim>& claim;
+    const int uncaught = std::uncaught_exceptions();
+    ~AbandonOnThrow() {
+      if (std::uncaught_exceptions() <= uncaught) return;
+      try {
+        if (writer) writer->close("error: the run could not start");
+      } catch (...) {
+      }
+      if (claim) claim->abandon();
+    }
+  } abandon_on_throw{writer_holder, claim};
   if (options.write_trace) {
     std::vector<InputFile> inputs = options.inputs;
     inputs.push_back({scenario.path(), "the scenario"});
