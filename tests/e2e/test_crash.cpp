@@ -82,18 +82,24 @@ TEST_CASE("a run killed with SIGKILL halfway leaves a readable, repairable trace
           out.c_str(), "--quiet", static_cast<char*>(nullptr));
     _exit(127);
   }
-  // Wait (no timing: only for progress) until half the run is on disk, then kill it.
+  // Let the run go in slices of about 1 ms (SIGCONT, sleep, SIGSTOP: no timing, only progress)
+  // until half of it is on disk, then kill it while it is stopped. A run of 60 s simulated
+  // takes about 0.1 s here, so looking at it while it ran free could miss it, and the finished
+  // run renames its trace away; a slice is about 1 s simulated, far short of the 30 s left.
   std::int64_t seen = -1;
   int status = 0;
   bool exited = false;
   for (;;) {
-    seen = servo_rows(file);
-    if (seen >= half) break;
-    if (waitpid(child, &status, WNOHANG) == child) {
+    REQUIRE(kill(child, SIGSTOP) == 0);
+    REQUIRE(waitpid(child, &status, WUNTRACED) == child);   // stopped, or ended before it
+    if (!WIFSTOPPED(status)) {
       exited = true;
       break;
     }
-    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    seen = servo_rows(file);
+    if (seen >= half) break;
+    REQUIRE(kill(child, SIGCONT) == 0);
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
   }
   if (!exited) {
     REQUIRE(kill(child, SIGKILL) == 0);
