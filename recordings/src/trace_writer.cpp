@@ -207,6 +207,28 @@ class TraceWriterWorker {
     return ++submitted_;
   }
 
+  // Hands jobs[0..n) over in order under one lock with one wake-up of the writer (a flush of
+  // every table); returns the last one's ticket. Rethrows a failure of an earlier job.
+  std::uint64_t submit_all(const Job* jobs, std::size_t n) {
+    if (!threaded_) {
+      std::uint64_t ticket = submitted_;
+      for (std::size_t i = 0; i < n; ++i) ticket = submit(jobs[i]);
+      return ticket;
+    }
+    std::unique_lock lock(mutex_);
+    if (error_) std::rethrow_exception(error_);
+    for (std::size_t i = 0; i < n; ++i) {
+      const bool flush = jobs[i].block == nullptr && !jobs[i].create;
+      if (flush && last_was_flush_) continue;   // as in submit()
+      last_was_flush_ = flush;
+      ring_[(head_ + size_) % ring_.size()] = jobs[i];
+      ++size_;
+      ++submitted_;
+    }
+    wake_.notify_one();
+    return submitted_;
+  }
+
   // Waits until the job with this ticket (and every one before it) is done. Rethrows the first
   // failure.
   void wait_for(std::uint64_t ticket) {
@@ -616,6 +638,7 @@ struct TraceWriter::Impl {
   std::vector<std::pair<std::string, std::function<void(hid_t)>>> pending;
   // Ordered by name, so the file's layout does not depend on first use.
   std::map<std::string, std::unique_ptr<TraceTable>> tables;
+  std::vector<Job> flush_jobs;   // flush()'s hand-over, one per table and the flush
   DiskReserve reserve;   // given back at close(), for what closing writes
   hsize_t size_limit = 0;   // bytes: the process's file size limit (RLIMIT_FSIZE), 0 for none
   bool closed = false;
@@ -667,6 +690,7 @@ void TraceWriter::Impl::freeze() {
     table->impl_->allocate();
     blocks += table->impl_->blocks.size();
   }
+  flush_jobs.reserve(tables.size() + 1);
   state.frozen = true;
   state.worker.start(options.background, 2 * blocks + 3, [this](const Job& job) { run(job); });
   state.worker.submit(Job{nullptr, true});
@@ -838,10 +862,25 @@ std::uint64_t TraceWriter::flush() {
     h5::check(H5Fflush(w.file.get(), H5F_SCOPE_LOCAL), w.context() + ": cannot flush");
     return 0;
   }
-  for (auto& [name, table] : w.tables) {
-    if (table->impl_->started) table->impl_->hand_over();
+  if (!w.options.background) {
+    // Inline: each block is written as it is handed over (a table's only block comes back).
+    for (auto& [name, table] : w.tables) {
+      if (table->impl_->started) table->impl_->hand_over();
+    }
+    return w.state.worker.submit(Job{nullptr});
   }
-  return w.state.worker.submit(Job{nullptr});
+  // Every table's block, then the flush, handed over together: one wake-up of the writer. A
+  // table takes its next block first (from a pool of 4, the writer returns them as it goes).
+  std::vector<Job>& jobs = w.flush_jobs;   // sized at freeze: no allocation here
+  jobs.clear();
+  for (auto& [name, table] : w.tables) {
+    TraceTable::Impl& t = *table->impl_;
+    if (!t.started || t.current == nullptr || t.current->count == 0) continue;
+    jobs.push_back(Job{t.current});
+    t.current = t.take_free_block();
+  }
+  jobs.push_back(Job{nullptr});
+  return w.state.worker.submit_all(jobs.data(), jobs.size());
 }
 
 void TraceWriter::wait() {

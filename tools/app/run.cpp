@@ -3,6 +3,7 @@
 #include "graspsim_version.hpp"
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cinttypes>
 #include <cmath>
@@ -73,24 +74,28 @@ struct OptionalWriter {
 
 // Crash safety (recordings/README.md): a run killed at any moment loses less than kFlushSimulated
 // of simulated time, however far the writer thread lags. The trace is flushed every flush
-// interval (at most kFlushSimulated / 2 of simulated time), and before a flush is handed to the
-// writer the flush before it must be on disk: the loop waits for it if need be (a slow disk
-// slows the run rather than break the bound). So the file always holds every tick up to the
-// flush before last, less than two intervals ago. It is also flushed at least every kFlushWall
-// seconds of wall time (a run slower than real time). The wall clock is read every
-// kWallCheckTicks ticks; it decides only when rows reach the disk, never what is written.
+// interval (at most kFlushSimulated / (kFlushesInFlight + 1) of simulated time), and before a
+// flush is handed to the writer the one kFlushesInFlight flushes before it must be on disk: the
+// loop waits for it if need be (a slow disk slows the run rather than break the bound). So the
+// file always holds every tick up to kFlushesInFlight + 1 intervals ago. One in flight: two
+// cost the 40 s lift 12 ms more process CPU than none (three times the flushes), one 6 ms
+// (recordings/README.md "Crash safety"). It is also flushed at least every kFlushWall seconds of
+// wall time (a run slower than real time). The wall clock is read every kWallCheckTicks ticks;
+// it decides only when rows reach the disk, never what is written.
 constexpr double kFlushSimulated = 0.25;   // s, simulated
+constexpr int kFlushesInFlight = 1;
 constexpr double kFlushWall = 0.9;         // s, wall (under 1 s, with the check interval's slack)
 constexpr std::int64_t kWallCheckTicks = 64;
 
 // Servo ticks between flushes on simulated time: the largest whole number of physics (and
-// haptic) periods within kFlushSimulated / 2, so that every flush interval holds the same number
-// of rows of every loop and each table's chunk can be exactly one interval (each chunk is then
-// written once, whole: recordings/README.md "Cost"). 360 ticks (0.12 s) at 3000/500/50 Hz. If
-// one physics period is longer than that: floor(kFlushSimulated / 2 * rate_servo).
+// haptic) periods within kFlushSimulated / (kFlushesInFlight + 1), so that every flush interval
+// holds the same number of rows of every loop and each table's chunk can be exactly one interval
+// (each chunk is then written once, whole: recordings/README.md "Cost"). 360 ticks (0.12 s) at
+// 3000/500/50 Hz. If one physics period is longer than that: that limit, floor(kFlushSimulated /
+// (kFlushesInFlight + 1) * rate_servo).
 std::int64_t flush_interval_ticks(const Model& model) {
-  const std::int64_t limit =
-      std::max<std::int64_t>(1, static_cast<std::int64_t>(std::floor(kFlushSimulated / 2 * model.rates.servo)));
+  const std::int64_t limit = std::max<std::int64_t>(
+      1, static_cast<std::int64_t>(std::floor(kFlushSimulated / (kFlushesInFlight + 1) * model.rates.servo)));
   const Divisors d = divisors(model.rates);
   const std::int64_t period = std::lcm(d.haptic, d.physics);
   return period <= limit ? limit / period * period : limit;
@@ -307,7 +312,9 @@ RunResult run_scenario(const scripting::Scenario& scenario, const RunOptions& op
     std::optional<recordings::TraceRecorder> recorder;
     const std::int64_t flush_ticks = flush_interval_ticks(model);
     std::int64_t until_flush = flush_ticks;   // servo ticks to the next flush on simulated time
-    std::uint64_t last_flush_ticket = 0;      // the last flush handed to the writer
+    // The tickets of the last kFlushesInFlight flushes handed to the writer, oldest at `oldest`.
+    std::array<std::uint64_t, kFlushesInFlight> flush_tickets{};
+    std::size_t oldest = 0;
     if (writer_holder) recorder.emplace(*writer_holder, model, options.block_rows > 0 ? 0 : flush_ticks);
     std::vector<DeviceColumns> device_tables;
     if (writer_holder) {
@@ -446,9 +453,10 @@ RunResult run_scenario(const scripting::Scenario& scenario, const RunOptions& op
         // of what logging cost the run loop (perf, the 40 s lift).
         if (--until_flush == 0 ||
             (n % kWallCheckTicks == 0 && seconds_since(last_flush) >= kFlushWall)) {
-          // The flush before this one must be on disk before this one is queued (kFlushSimulated).
-          writer_holder->wait(last_flush_ticket);
-          last_flush_ticket = writer_holder->flush();
+          // The flush kFlushesInFlight before this one must be on disk first (kFlushSimulated).
+          writer_holder->wait(flush_tickets[oldest]);
+          flush_tickets[oldest] = writer_holder->flush();
+          oldest = (oldest + 1) % flush_tickets.size();
           last_flush = Clock::now();
           until_flush = flush_ticks - (n + 1) % flush_ticks;   // rare: keep the simulated phase
         }
