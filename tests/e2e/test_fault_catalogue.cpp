@@ -387,8 +387,8 @@ TEST_CASE("catalogue: default output names stay inside the working directory", "
 // executable's own pwrite (HDF5's writes go through it: a program's definition comes before
 // libc's), which sleeps `delay` ms per call in the forked run: the writer thread lags, the loop
 // does not. Swept over the kill tick and the delay. Without the wait the writer falls behind by
-// up to its pool of 4 blocks per table: with the wait removed this test loses 782 ticks at no
-// delay and 1502 (0.50 s) at 1 and 5 ms, and fails.
+// up to its pool of 4 blocks per table: with the wait removed this test lost 782 and 1140 ticks
+// (two tries) at no delay and 1502 (0.50 s) at 1 and 5 ms, and failed.
 namespace {
 
 std::atomic<int> g_pwrite_delay_ms{0};   // ms per pwrite of this process (0: none)
