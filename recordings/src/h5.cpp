@@ -9,6 +9,14 @@
 namespace graspsim::recordings::h5 {
 namespace {
 
+// HDF5 1.10 frees a file whose H5Fclose fails (a full disk) but keeps its identifier, and the
+// handler it registers with atexit (H5_term_library) then closes that file again: SIGSEGV in
+// H5F__close_cb after main returns. Every HDF5 object this module opens is closed by its owner
+// before exit, so the library need not be shut down then; H5dont_atexit, which must come before
+// the library initialises and does not initialise it, keeps the handler from being registered.
+// Static initialisation runs before main, and no initialiser of this program calls HDF5.
+[[maybe_unused]] const herr_t kNoShutdownAtExit = H5dont_atexit();
+
 // Collects the innermost error of the stack (the walk goes upward, innermost first).
 herr_t take_innermost(unsigned n, const H5E_error2_t* error, void* out) {
   if (n == 0 && error != nullptr && error->desc != nullptr) {

@@ -9,6 +9,7 @@
 #include <condition_variable>
 #include <cstring>
 #include <exception>
+#include <filesystem>
 #include <functional>
 #include <map>
 #include <mutex>
@@ -17,6 +18,9 @@
 #include <type_traits>
 #include <vector>
 
+#include <sys/resource.h>
+
+#include "disk_reserve.hpp"
 #include "h5.hpp"
 
 namespace graspsim::recordings {
@@ -172,14 +176,16 @@ class TraceWriterWorker {
     threaded_ = thread;
   }
 
-  // Hands a job over (runs it at once without a thread). Rethrows a failure of an earlier job.
-  void submit(const Job& job) {
+  // Hands a job over (runs it at once without a thread) and returns its ticket: the number of
+  // jobs submitted up to it, for wait_for(). Rethrows a failure of an earlier job.
+  std::uint64_t submit(const Job& job) {
     // A flush right after a flush (no block between them) adds nothing: dropped here, by the
     // order of submission alone, so the file's HDF5 calls never depend on the writer's timing.
+    // Its ticket is the earlier flush's, which leaves the file in the same state.
     const bool flush = job.block == nullptr && !job.create;
     if (flush && last_was_flush_) {
       if (!threaded_) rethrow();
-      return;
+      return submitted_;
     }
     last_was_flush_ = flush;
     if (!threaded_) {
@@ -190,13 +196,47 @@ class TraceWriterWorker {
         error_ = std::current_exception();
         throw;
       }
-      return;
+      done_ = ++submitted_;
+      return submitted_;
     }
     std::unique_lock lock(mutex_);
     if (error_) std::rethrow_exception(error_);
     ring_[(head_ + size_) % ring_.size()] = job;
     ++size_;
     wake_.notify_one();
+    return ++submitted_;
+  }
+
+  // Hands jobs[0..n) over in order under one lock with one wake-up of the writer (a flush of
+  // every table); returns the last one's ticket. Rethrows a failure of an earlier job.
+  std::uint64_t submit_all(const Job* jobs, std::size_t n) {
+    if (!threaded_) {
+      std::uint64_t ticket = submitted_;
+      for (std::size_t i = 0; i < n; ++i) ticket = submit(jobs[i]);
+      return ticket;
+    }
+    std::unique_lock lock(mutex_);
+    if (error_) std::rethrow_exception(error_);
+    for (std::size_t i = 0; i < n; ++i) {
+      const bool flush = jobs[i].block == nullptr && !jobs[i].create;
+      if (flush && last_was_flush_) continue;   // as in submit()
+      last_was_flush_ = flush;
+      ring_[(head_ + size_) % ring_.size()] = jobs[i];
+      ++size_;
+      ++submitted_;
+    }
+    wake_.notify_one();
+    return submitted_;
+  }
+
+  // Waits until the job with this ticket (and every one before it) is done. Rethrows the first
+  // failure.
+  void wait_for(std::uint64_t ticket) {
+    if (threaded_) {
+      std::unique_lock lock(mutex_);
+      done_cv_.wait(lock, [this, ticket] { return done_ >= ticket || error_; });
+    }
+    rethrow();
   }
 
   // Waits until every job submitted so far is done. Rethrows the first failure.
@@ -254,7 +294,9 @@ class TraceWriterWorker {
       if (failed && !error_) error_ = failed;
       head_ = (head_ + 1) % ring_.size();
       --size_;
+      ++done_;
       busy_ = false;
+      done_cv_.notify_all();
       if (size_ == 0) idle_.notify_all();
     }
   }
@@ -264,9 +306,11 @@ class TraceWriterWorker {
   std::size_t head_ = 0, size_ = 0;
   bool threaded_ = false, busy_ = false, stopping_ = false;
   bool last_was_flush_ = false;   // the last job submitted was a flush (submitting thread only)
+  std::uint64_t submitted_ = 0;   // jobs submitted (submitting thread only)
+  std::uint64_t done_ = 0;        // jobs done, failed ones included (guarded by mutex_)
   std::exception_ptr error_;
   std::mutex mutex_;
-  std::condition_variable wake_, idle_, returned_;
+  std::condition_variable wake_, idle_, returned_, done_cv_;
   std::thread worker_;
 };
 
@@ -307,7 +351,8 @@ struct TraceTable::Impl {
   std::vector<const Column*> integers;   // the columns converted and checked one by one
   bool direct = false;           // whole chunks go to the file as they are (H5Dwrite_chunk)
   std::vector<unsigned char> packed;   // block_rows x packed_width
-  std::int64_t written = 0;      // rows on disk
+  std::int64_t written = 0;      // rows handed to HDF5 (in the file once it is flushed)
+  std::int64_t durable = 0;      // rows written before the last successful H5Fflush: on disk
 
   std::string context() const { return "trace " + quoted(file_path); }
   std::string column_context(const std::string& column) const {
@@ -593,13 +638,18 @@ struct TraceWriter::Impl {
   std::vector<std::pair<std::string, std::function<void(hid_t)>>> pending;
   // Ordered by name, so the file's layout does not depend on first use.
   std::map<std::string, std::unique_ptr<TraceTable>> tables;
+  std::vector<Job> flush_jobs;   // flush()'s hand-over, one per table and the flush
+  DiskReserve reserve;   // given back at close(), for what closing writes
+  hsize_t size_limit = 0;   // bytes: the process's file size limit (RLIMIT_FSIZE), 0 for none
   bool closed = false;
+  bool marked = false;   // close() wrote the final status
 
   std::string context() const { return "trace " + quoted(path); }
   void require_open() const {
     if (closed) throw TraceError(context() + ": used after close");
   }
   void set_root_attribute(const std::string& name, std::function<void(hid_t)> write);
+  std::string cut_to_last_flush(hid_t file_id);
   void freeze();
   void run(const Job& job);   // on the writer thread (or inline)
 };
@@ -640,6 +690,7 @@ void TraceWriter::Impl::freeze() {
     table->impl_->allocate();
     blocks += table->impl_->blocks.size();
   }
+  flush_jobs.reserve(tables.size() + 1);
   state.frozen = true;
   state.worker.start(options.background, 2 * blocks + 3, [this](const Job& job) { run(job); });
   state.worker.submit(Job{nullptr, true});
@@ -656,9 +707,11 @@ void TraceWriter::Impl::run(const Job& job) {
     return;
   }
   if (job.block == nullptr) {
+    if (state.worker.failure()) return;   // after a failure nothing more reaches the file
     if (H5Fflush(file.get(), H5F_SCOPE_LOCAL) < 0) {
       throw TraceError(context() + ": cannot flush: " + h5::last_error());
     }
+    for (auto& [name, table] : tables) table->impl_->durable = table->impl_->written;
     return;
   }
   Block& block = *job.block;
@@ -677,6 +730,17 @@ void TraceWriter::Impl::run(const Job& job) {
     }
   } give_back{state, table, block};
   if (state.worker.failure()) return;   // after a failure, later rows are not written
+  if (size_limit > 0) {
+    // A write past RLIMIT_FSIZE fails with EFBIG, and then closing could not write either: stop
+    // short of it by the reserve's size, as a full disk stops the writer with the reserve held.
+    hsize_t size = 0;
+    const hsize_t bytes = static_cast<hsize_t>(block.count * table.packed_width);
+    if (H5Fget_filesize(file.get(), &size) >= 0 && size + bytes + options.reserve_bytes > size_limit) {
+      throw TraceError(context() + ", table " + quoted("/" + table.name) + ": cannot append rows: the file would pass " +
+                       std::to_string(size_limit) + " bytes, this process's file size limit (ulimit -f), less " +
+                       std::to_string(options.reserve_bytes) + " kept for closing it");
+    }
+  }
   table.write_block(block);
 }
 
@@ -716,6 +780,11 @@ TraceWriter::TraceWriter(const std::string& path, TraceOptions options)
   h5::write_string_attribute(impl_->root.get(), "status", "running", where);
   h5::check(H5Fflush(impl_->file.get(), H5F_SCOPE_LOCAL), where);
   release.impl = nullptr;
+  const std::string directory = std::filesystem::path(path).parent_path().string();
+  impl_->reserve = DiskReserve(directory.empty() ? "." : directory, options.reserve_bytes);
+  struct rlimit limit{};
+  if (getrlimit(RLIMIT_FSIZE, &limit) == 0 && limit.rlim_cur != RLIM_INFINITY)
+    impl_->size_limit = static_cast<hsize_t>(limit.rlim_cur);
 }
 
 TraceWriter::~TraceWriter() {
@@ -784,24 +853,44 @@ void TraceWriter::set_attribute(const std::string& name, std::int64_t value) {
   });
 }
 
-void TraceWriter::flush() {
+std::uint64_t TraceWriter::flush() {
   Impl& w = *impl_;
   w.require_open();
   if (!w.state.frozen) {
     h5::Lock lock;
     h5::Quiet quiet;
     h5::check(H5Fflush(w.file.get(), H5F_SCOPE_LOCAL), w.context() + ": cannot flush");
-    return;
+    return 0;
   }
+  if (!w.options.background) {
+    // Inline: each block is written as it is handed over (a table's only block comes back).
+    for (auto& [name, table] : w.tables) {
+      if (table->impl_->started) table->impl_->hand_over();
+    }
+    return w.state.worker.submit(Job{nullptr});
+  }
+  // Every table's block, then the flush, handed over together: one wake-up of the writer. A
+  // table takes its next block first (from a pool of 4, the writer returns them as it goes).
+  std::vector<Job>& jobs = w.flush_jobs;   // sized at freeze: no allocation here
+  jobs.clear();
   for (auto& [name, table] : w.tables) {
-    if (table->impl_->started) table->impl_->hand_over();
+    TraceTable::Impl& t = *table->impl_;
+    if (!t.started || t.current == nullptr || t.current->count == 0) continue;
+    jobs.push_back(Job{t.current});
+    t.current = t.take_free_block();
   }
-  w.state.worker.submit(Job{nullptr});
+  jobs.push_back(Job{nullptr});
+  return w.state.worker.submit_all(jobs.data(), jobs.size());
 }
 
 void TraceWriter::wait() {
   impl_->require_open();
   if (impl_->state.frozen) impl_->state.worker.drain();
+}
+
+void TraceWriter::wait(std::uint64_t ticket) {
+  impl_->require_open();
+  if (impl_->state.frozen) impl_->state.worker.wait_for(ticket);
 }
 
 void TraceWriter::close(const std::string& status) {
@@ -837,8 +926,15 @@ void TraceWriter::close(const std::string& status) {
       }
     }
   }
+  // The room set aside for this moment goes back to the file system: what follows writes
+  // metadata and attributes even when the disk is full.
+  w.reserve.release();
   h5::Lock lock;
   h5::Quiet quiet;
+  // After a failure, rows past the last successful flush may be only partly on disk: every
+  // table is cut back to its last flush, so the file holds nothing it cannot vouch for.
+  std::string kept;
+  if (!failure.empty() && w.state.frozen) kept = w.cut_to_last_flush(w.file.get());
   // Every object of the file is closed before the file itself, so H5Fclose really closes it
   // (and ends SWMR writing, clearing the superblock's status flags).
   for (auto& [name, table] : w.tables) {
@@ -847,10 +943,16 @@ void TraceWriter::close(const std::string& status) {
     table->impl_->memory_type.reset();
   }
   w.root.reset();
-  if (w.file.close() < 0 && failure.empty()) {
-    failure = w.context() + ": cannot close: " + h5::last_error();
+  if (w.file.close() < 0) {
+    // HDF5 1.10 frees a file whose close failed but keeps its identifier (h5.cpp: the library is
+    // then never shut down at exit, which would close it again): nothing more is done with it.
+    if (failure.empty()) failure = w.context() + ": cannot close: " + h5::last_error();
+    w.pending.clear();
+    throw TraceError(failure + (kept.empty() ? "" : "; " + kept) +
+                     "; its status could not be written (it says \"running\": graspsim repair " + w.path + ")");
   }
   // Reopened without SWMR for what SWMR cannot write: the kept attributes and the status.
+  bool marked = false;
   try {
     const std::string where = w.context() + ": cannot reopen to write the status";
     h5::Handle fapl = file_access(w.options.swmr, where);
@@ -858,6 +960,7 @@ void TraceWriter::close(const std::string& status) {
     // fails and the status stays "running". The reader sees the final attributes on reopening.
     h5::check(H5Pset_file_locking(fapl.get(), 0, 1), where);
     h5::Handle file = h5::checked(H5Fopen(w.path.c_str(), H5F_ACC_RDWR, fapl.get()), H5Fclose, where);
+    if (!failure.empty() && kept.empty() && w.state.frozen) kept = w.cut_to_last_flush(file.get());
     h5::Handle root = h5::checked(H5Gopen2(file.get(), "/", H5P_DEFAULT), H5Gclose, where);
     for (const auto& [name, write] : w.pending) {
       try {
@@ -866,18 +969,47 @@ void TraceWriter::close(const std::string& status) {
         if (failure.empty()) failure = e.what();
       }
     }
-    h5::write_string_attribute(root.get(), "status",
-                               failure.empty() ? status : "error: " + failure, w.context());
+    const std::string text = failure + (kept.empty() ? "" : "; " + kept);
+    h5::write_string_attribute(root.get(), "status", failure.empty() ? status : "error: " + text, w.context());
     root.reset();
     if (file.close() < 0) throw TraceError(w.context() + ": cannot close: " + h5::last_error());
+    marked = true;
+    w.marked = true;
   } catch (const TraceError& e) {
     if (failure.empty()) failure = e.what();
   }
   w.pending.clear();
-  if (!failure.empty()) throw TraceError(failure);
+  if (!failure.empty()) {
+    throw TraceError(failure + (kept.empty() ? "" : "; " + kept) +
+                     (marked ? "" : "; its status could not be written (graspsim repair " + w.path + ")"));
+  }
+}
+
+// Sets every table's extent back to the rows of its last successful flush (H5Fflush), and says
+// what is kept: "kept up to the last flush: /haptic 240 rows, /physics 24 rows, /servo 1440 rows".
+// A table that cannot be cut is named with its rows as they are.
+std::string TraceWriter::Impl::cut_to_last_flush(hid_t file_id) {
+  std::string kept;
+  bool cut = true;
+  for (auto& [name, table] : tables) {
+    TraceTable::Impl& t = *table->impl_;
+    const hsize_t rows[1] = {static_cast<hsize_t>(t.durable)};
+    h5::Handle opened;
+    hid_t dataset = t.dataset.get();
+    if (!t.dataset.valid()) {
+      opened = h5::Handle(H5Dopen2(file_id, ("/" + name).c_str(), H5P_DEFAULT), H5Dclose);
+      dataset = opened.get();
+    }
+    if (dataset < 0 || H5Dset_extent(dataset, rows) < 0) cut = false;
+    kept += (kept.empty() ? "" : ", ") + quoted("/" + name) + " " + std::to_string(t.durable) + " rows";
+  }
+  if (!cut) return "";   // tried again after reopening without SWMR
+  return "kept up to the last flush: " + kept;
 }
 
 bool TraceWriter::is_closed() const { return impl_->closed; }
+
+bool TraceWriter::marked() const { return impl_->marked; }
 
 const std::string& TraceWriter::path() const { return impl_->path; }
 

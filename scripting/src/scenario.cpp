@@ -143,6 +143,7 @@ Scenario Scenario::load_source(const std::string& source, const std::string& pat
     s.refuse_unstable_ = parts.refuse_unstable;
     s.fingers_ = std::move(parts.fingers);
     s.expectations_ = std::move(parts.expectations);
+    s.files_ = std::move(parts.files);
     for (detail::TrajectoryParts& t : parts.trajectories) {
       s.trajectories_.push_back(TrajectorySpec{std::move(t.waypoints), t.interpolation, t.function_ref});
       if (t.function_ref != 0) s.uses_view_ = s.uses_view_ || takes_view(state, t.function_ref);

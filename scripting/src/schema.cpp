@@ -268,7 +268,8 @@ SleepParams read_sleep(const LuaValue* value) {
   return sleep;
 }
 
-BodyParams object(const LuaValue& value, std::size_t index, const std::string& base_dir) {
+BodyParams object(const LuaValue& value, std::size_t index, const std::string& base_dir,
+                  std::vector<std::string>& files) {
   const Where where{element_label("objects", index, value, "name"), ""};
   const Record r(value, where, TableKind::kObject);
   BodyParams body;
@@ -325,6 +326,7 @@ BodyParams object(const LuaValue& value, std::size_t index, const std::string& b
       const std::filesystem::path given(name);
       const std::string path = given.is_absolute() || base_dir.empty() ? name : (std::filesystem::path(base_dir) / given).string();
       MeshFile file;
+      files.push_back(path);
       try {
         file = read_mesh_file(path);
       } catch (const ConversionError& e) {
@@ -641,7 +643,7 @@ ScenarioParts convert_scenario(const LuaValue& root, const std::string& default_
 
   if (const LuaValue* objects = r.get("objects")) {
     const auto elements = array(*objects, r.at("objects"), "an array of objects { {name = ...}, ... }");
-    for (std::size_t i = 0; i < elements.size(); ++i) s.model.bodies.push_back(object(*elements[i], i + 1, base_dir));
+    for (std::size_t i = 0; i < elements.size(); ++i) s.model.bodies.push_back(object(*elements[i], i + 1, base_dir, s.files));
   }
   if (const LuaValue* fingers = r.get("fingers")) {
     const auto elements = array(*fingers, r.at("fingers"), "an array of fingers { {name = ...}, ... }");

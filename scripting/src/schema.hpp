@@ -54,6 +54,7 @@ struct ScenarioParts {
   std::vector<FingerSetup> fingers;
   std::vector<TrajectoryParts> trajectories;   // one per finger
   std::vector<Expectation> expectations;
+  std::vector<std::string> files;   // every mesh file read, as opened (Scenario::files)
 };
 
 // Checks and converts the scenario table. Functions in it must carry registry references.

@@ -1,7 +1,8 @@
-// Crash safety end to end: `graspsim run` on a long scenario is killed with SIGKILL halfway;
-// the file it leaves opens read-only for h5py (SWMR) and for our reader, holds every tick up to
-// the last flush with the run's real values, says `running`, and after `graspsim repair` opens
-// for h5dump and any plain reader, saying `cut: repaired`.
+// Crash safety end to end: `graspsim run --out X.h5` on a long scenario is killed with SIGKILL
+// halfway; the file it leaves, X.h5.partial (a run writes its trace under that name and renames
+// it only when it ends), opens read-only for h5py (SWMR) and for our reader, holds every tick up
+// to the last flush with the run's real values, says `running`, and after `graspsim repair`
+// opens for h5dump and any plain reader, saying `cut: repaired`.
 #include <catch2/catch.hpp>
 
 #include <chrono>
@@ -69,28 +70,36 @@ print(n)
 
 TEST_CASE("a run killed with SIGKILL halfway leaves a readable, repairable trace", "[e2e][crash]") {
   // 60 s simulated at 3000 Hz: 180000 servo ticks; killed once 30 s are on disk.
-  const std::string file = kTmp + "/e2e_crash.h5";
+  const std::string out = kTmp + "/e2e_crash.h5";
+  const std::string file = out + ".partial";   // where the killed run's trace stays
+  std::remove(out.c_str());
   std::remove(file.c_str());
   const std::int64_t total = 180000, half = total / 2;
   const pid_t child = fork();
   REQUIRE(child >= 0);
   if (child == 0) {
     execl(kCli.c_str(), kCli.c_str(), "run", kScenario.c_str(), "--duration", "60", "--out",
-          file.c_str(), "--quiet", static_cast<char*>(nullptr));
+          out.c_str(), "--quiet", static_cast<char*>(nullptr));
     _exit(127);
   }
-  // Wait (no timing: only for progress) until half the run is on disk, then kill it.
+  // Let the run go in slices of about 1 ms (SIGCONT, sleep, SIGSTOP: no timing, only progress)
+  // until half of it is on disk, then kill it while it is stopped. A run of 60 s simulated
+  // takes about 0.1 s here, so looking at it while it ran free could miss it, and the finished
+  // run renames its trace away; a slice is about 1 s simulated, far short of the 30 s left.
   std::int64_t seen = -1;
   int status = 0;
   bool exited = false;
   for (;;) {
-    seen = servo_rows(file);
-    if (seen >= half) break;
-    if (waitpid(child, &status, WNOHANG) == child) {
+    REQUIRE(kill(child, SIGSTOP) == 0);
+    REQUIRE(waitpid(child, &status, WUNTRACED) == child);   // stopped, or ended before it
+    if (!WIFSTOPPED(status)) {
       exited = true;
       break;
     }
-    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    seen = servo_rows(file);
+    if (seen >= half) break;
+    REQUIRE(kill(child, SIGCONT) == 0);
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
   }
   if (!exited) {
     REQUIRE(kill(child, SIGKILL) == 0);
@@ -116,7 +125,7 @@ TEST_CASE("a run killed with SIGKILL halfway leaves a readable, repairable trace
   }
   CHECK(bad == 0);
   // /physics (every 60th tick) reaches the last flush too: the run hands every table to the
-  // writer together every flush interval (750 ticks); a table whose block fills in between (after
+  // writer together every flush interval (360 ticks); a table whose block fills in between (after
   // a wall-clock flush) goes ahead alone, so /physics lags /servo by at most one interval plus
   // one physics period.
   const recordings::Dataset physics_tick = recordings::read_dataset(file, "/physics/tick");
@@ -124,7 +133,9 @@ TEST_CASE("a run killed with SIGKILL halfway leaves a readable, repairable trace
   const std::int64_t m = static_cast<std::int64_t>(physics_tick.shape.at(0));
   REQUIRE(m > 100);
   CHECK(hashes.bits.size() == static_cast<std::size_t>(m));
-  CHECK((m - 1) * 60 + 60 + 750 >= n);
+  CHECK((m - 1) * 60 + 60 + 360 >= n);
+  // Nothing took the output's name: a killed run never renamed its trace.
+  CHECK(shell("test -e " + out).status != 0);
   // The rows are the run's real values: the first 2 s of /physics/state_hash equal those of the
   // same scenario run here (bit-identical determinism, and no zero-filled chunk on disk).
   {

@@ -107,7 +107,9 @@ std::string DeviceRegistry::usages(bool built_only) const {
 DeviceRegistry default_registry() {
   DeviceRegistry r;
   r.add({"scripted", "scripted", false, false, make_scripted});
-  r.add({"replay", "replay:TRACE.h5", false, false, make_replay});
+  DeviceKind replay{"replay", "replay:TRACE.h5", false, false, make_replay};
+  replay.reads_file = true;
+  r.add(replay);
   // A simulated device is not real (no hand on it): the run stays as fast as possible and
   // deterministic. UDP and OpenHaptics devices are real: the run is paced.
   r.add({"sim-phantom", "sim-phantom[:MODEL]", false, true, make_sim_phantom_device});
@@ -196,6 +198,8 @@ DevicePlan plan_devices(const scripting::Scenario& scenario, const std::vector<s
     }
     plan.real.push_back(real);
     plan.script_alongside.push_back(!kind->runs_script);
+    if (kind->reads_file)
+      plan.files.push_back({plan.specs[f].arg, "the " + kind->name + " file of finger '" + model.fingers[f].name + "'"});
   }
   return plan;
 }

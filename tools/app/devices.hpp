@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "app/output_file.hpp"
 #include "graspsim/hw/device.hpp"
 #include "graspsim/hw/trajectory.hpp"
 #include "graspsim/scripting/scenario.hpp"
@@ -57,6 +58,8 @@ struct DeviceKind {
   // runs it alongside; sim-phantom: the hand follows it). false (udp, phantom): the run loop runs
   // it alongside (RunOptions::script_alongside).
   bool runs_script = true;
+  // ARG names a file the device reads (replay:TRACE.h5): the run's output may not be that file.
+  bool reads_file = false;
 };
 
 class DeviceRegistry {
@@ -86,6 +89,8 @@ struct DevicePlan {
   std::vector<bool> recorded() const;
   // Fingers whose device does not run the finger's script (DeviceKind::runs_script false).
   std::vector<bool> script_alongside;
+  // The files the devices read (DeviceKind::reads_file), for RunOptions::inputs.
+  std::vector<InputFile> files;
 };
 
 // `options` are the --device values "FINGER=SPEC" in the order given. Throws DeviceError for a

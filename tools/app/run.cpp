@@ -3,10 +3,14 @@
 #include "graspsim_version.hpp"
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cinttypes>
 #include <cmath>
+#include <csignal>
 #include <cstdio>
+#include <cstring>
+#include <exception>
 #include <memory>
 #include <numeric>
 #include <optional>
@@ -84,22 +88,30 @@ struct OptionalWriter {
   }
 };
 
-// Crash safety (recordings/README.md): the trace is flushed at least every kFlushSimulated
-// seconds of simulated time and at least every kFlushWall seconds of wall time, so a run killed
-// at any moment loses at most that much. The wall clock is read every kWallCheckTicks ticks;
+// Crash safety (recordings/README.md): a run killed at any moment loses less than kFlushSimulated
+// of simulated time, however far the writer thread lags. The trace is flushed every flush
+// interval (at most kFlushSimulated / (kFlushesInFlight + 1) of simulated time), and before a
+// flush is handed to the writer the one kFlushesInFlight flushes before it must be on disk: the
+// loop waits for it if need be (a slow disk slows the run rather than break the bound). So the
+// file always holds every tick up to kFlushesInFlight + 1 intervals ago. One in flight: two
+// cost the 40 s lift 12 ms more process CPU than none (three times the flushes), one 6 ms
+// (recordings/README.md "Crash safety"). It is also flushed at least every kFlushWall seconds of
+// wall time (a run slower than real time). The wall clock is read every kWallCheckTicks ticks;
 // it decides only when rows reach the disk, never what is written.
 constexpr double kFlushSimulated = 0.25;   // s, simulated
+constexpr int kFlushesInFlight = 1;
 constexpr double kFlushWall = 0.9;         // s, wall (under 1 s, with the check interval's slack)
 constexpr std::int64_t kWallCheckTicks = 64;
 
 // Servo ticks between flushes on simulated time: the largest whole number of physics (and
-// haptic) periods within kFlushSimulated, so that every flush interval holds the same number of
-// rows of every loop and each table's chunk can be exactly one interval (each chunk is then
-// written once, whole: recordings/README.md "Cost"). 720 ticks (0.24 s) at 3000/500/50 Hz. If
-// one physics period is longer than kFlushSimulated: floor(kFlushSimulated * rate_servo).
+// haptic) periods within kFlushSimulated / (kFlushesInFlight + 1), so that every flush interval
+// holds the same number of rows of every loop and each table's chunk can be exactly one interval
+// (each chunk is then written once, whole: recordings/README.md "Cost"). 360 ticks (0.12 s) at
+// 3000/500/50 Hz. If one physics period is longer than that: that limit, floor(kFlushSimulated /
+// (kFlushesInFlight + 1) * rate_servo).
 std::int64_t flush_interval_ticks(const Model& model) {
-  const std::int64_t limit =
-      std::max<std::int64_t>(1, static_cast<std::int64_t>(std::floor(kFlushSimulated * model.rates.servo)));
+  const std::int64_t limit = std::max<std::int64_t>(
+      1, static_cast<std::int64_t>(std::floor(kFlushSimulated / (kFlushesInFlight + 1) * model.rates.servo)));
   const Divisors d = divisors(model.rates);
   const std::int64_t period = std::lcm(d.haptic, d.physics);
   return period <= limit ? limit / period * period : limit;
@@ -170,7 +182,7 @@ bool RunResult::passed() const {
 RunResult run_scenario(const scripting::Scenario& scenario, const RunOptions& options) {
   const Model& model = scenario.model();
   RunResult result;
-  result.trace_path = options.out.empty() ? scenario.name() + ".h5" : options.out;
+  result.trace_path = options.out.empty() ? default_trace_name(scenario.name()) : options.out;
 
   recordings::TraceOptions trace_options;
   if (options.block_rows > 0) trace_options.block_rows = options.block_rows;
@@ -180,8 +192,33 @@ RunResult run_scenario(const scripting::Scenario& scenario, const RunOptions& op
   trace_options.background = options.background_writer;
   // Without a trace (the logging benchmark's baseline) every attribute and row is skipped.
   std::optional<recordings::TraceWriter> writer_holder;
-  if (options.write_trace) writer_holder.emplace(result.trace_path, trace_options);   // throws if it cannot
-  else result.trace_path.clear();
+  std::optional<OutputClaim> claim;   // the output path, locked; the trace is written to its partial name
+  // A failure that escapes before the loop (the file or its first attributes cannot be
+  // written: a full disk) leaves a partial trace without a tick: it is closed and removed, and
+  // the output path is as it was.
+  struct AbandonOnThrow {
+    std::optional<recordings::TraceWriter>& writer;
+    std::optional<OutputClaim>& claim;
+    const int uncaught = std::uncaught_exceptions();
+    ~AbandonOnThrow() {
+      if (std::uncaught_exceptions() <= uncaught) return;
+      try {
+        if (writer) writer->close("error: the run could not start");
+      } catch (...) {
+      }
+      if (claim) claim->abandon();
+    }
+  } abandon_on_throw{writer_holder, claim};
+  if (options.write_trace) {
+    std::vector<InputFile> inputs = options.inputs;
+    inputs.push_back({scenario.path(), "the scenario"});
+    for (const std::string& f : scenario.files()) inputs.push_back({f, "a mesh file of the scenario"});
+    refuse_input_as_output(result.trace_path, inputs);   // throws OutputError
+    claim.emplace(result.trace_path);                     // throws OutputError
+    writer_holder.emplace(claim->partial(), trace_options);   // throws TraceError if it cannot
+  } else {
+    result.trace_path.clear();
+  }
   OptionalWriter writer{writer_holder ? &*writer_holder : nullptr};
 
   // The file explains and replays itself: the scenario text, every parameter, rates, seed, build.
@@ -247,6 +284,14 @@ RunResult run_scenario(const scripting::Scenario& scenario, const RunOptions& op
   const auto start = Clock::now();
   std::optional<Simulation> sim_holder;
   bool realtime = false;   // this thread is SCHED_FIFO (until the loop ends)
+  bool started = false;    // every device was built: the run goes on to its first tick
+  // "interrupted [by SIGTERM] at t = T s".
+  const auto interrupted_at = [&options](double t) {
+    const int signal = options.interrupt_signal ? options.interrupt_signal->load() : 0;
+    const char* name = signal > 0 ? sigabbrev_np(signal) : nullptr;
+    return std::string("interrupted") + (name ? std::string(" by SIG") + name : std::string()) + " at t = " +
+           std::to_string(t) + " s";
+  };
   try {
     std::ostringstream device_list;
     {
@@ -274,6 +319,7 @@ RunResult run_scenario(const scripting::Scenario& scenario, const RunOptions& op
                     << " (max force " << devices.back()->limits().max_force << " N)\n";
       }
     }
+    started = true;
     writer.set_attribute("devices", device_list.str());
     std::vector<hw::DeviceSample> samples(devices.size());   // this tick's, as read (world)
     // The scripts of fingers whose device does not run them (RunOptions::script_alongside).
@@ -285,6 +331,9 @@ RunResult run_scenario(const scripting::Scenario& scenario, const RunOptions& op
     std::optional<recordings::TraceRecorder> recorder;
     const std::int64_t flush_ticks = flush_interval_ticks(model);
     std::int64_t until_flush = flush_ticks;   // servo ticks to the next flush on simulated time
+    // The tickets of the last kFlushesInFlight flushes handed to the writer, oldest at `oldest`.
+    std::array<std::uint64_t, kFlushesInFlight> flush_tickets{};
+    std::size_t oldest = 0;
     if (writer_holder) recorder.emplace(*writer_holder, model, options.block_rows > 0 ? 0 : flush_ticks);
     std::vector<DeviceColumns> device_tables;
     if (writer_holder) {
@@ -423,7 +472,10 @@ RunResult run_scenario(const scripting::Scenario& scenario, const RunOptions& op
         // of what logging cost the run loop (perf, the 40 s lift).
         if (--until_flush == 0 ||
             (n % kWallCheckTicks == 0 && seconds_since(last_flush) >= kFlushWall)) {
-          writer_holder->flush();
+          // The flush kFlushesInFlight before this one must be on disk first (kFlushSimulated).
+          writer_holder->wait(flush_tickets[oldest]);
+          flush_tickets[oldest] = writer_holder->flush();
+          oldest = (oldest + 1) % flush_tickets.size();
           last_flush = Clock::now();
           until_flush = flush_ticks - (n + 1) % flush_ticks;   // rare: keep the simulated phase
         }
@@ -469,13 +521,13 @@ RunResult run_scenario(const scripting::Scenario& scenario, const RunOptions& op
       // Paced (a hand on a device): Ctrl-C is seen at the next tick, not up to a second later.
       if (options.pacer && options.interrupt && options.interrupt->load()) {
         result.interrupted = true;
-        throw std::runtime_error("interrupted at t = " + std::to_string(sim.time()) + " s");
+        throw std::runtime_error(interrupted_at(sim.time()));
       }
       // Wall-clock checks only every 3000 ticks: they are the only clock reads in the loop.
       if (n % 3000 == 2999) {
         if (options.interrupt && options.interrupt->load()) {
           result.interrupted = true;
-          throw std::runtime_error("interrupted at t = " + std::to_string(sim.time()) + " s");
+          throw std::runtime_error(interrupted_at(sim.time()));
         }
         // The first progress line after 2 s: a quick run prints none.
         if (options.progress && !options.pacer && seconds_since(start) > 2.0 && seconds_since(last_progress) > 0.25) {
@@ -532,7 +584,26 @@ RunResult run_scenario(const scripting::Scenario& scenario, const RunOptions& op
     writer.set_attribute("warnings", stability.text());
     if (writer_holder) writer_holder->close(result.error.empty() ? "complete" : "error: " + result.error);
   } catch (const std::exception& e) {
+    result.trace_error = e.what();
     if (result.error.empty()) result.error = std::string("writing the trace: ") + e.what();
+  }
+  if (!started) {
+    // A device could not be built: the run never began, and nothing of it is kept.
+    result.not_started = true;
+    result.trace_error.clear();
+    result.trace_path.clear();
+    if (claim) claim->abandon();
+  } else if (claim && writer_holder && writer_holder->marked()) {
+    // Complete, or marked with its error: it may now take the output path.
+    try {
+      claim->commit();
+    } catch (const OutputError& e) {
+      result.trace_error = e.what();
+      result.trace_path = claim->partial();
+    }
+  } else if (claim) {
+    // Not even its status could be written: it stays under its partial name, like a cut trace.
+    result.trace_path = claim->partial();
   }
   return result;
 }

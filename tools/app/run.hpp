@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "app/output_file.hpp"
 #include "app/pacer.hpp"
 #include "graspsim/hw/device.hpp"
 #include "graspsim/scripting/scenario.hpp"
@@ -17,7 +18,12 @@
 namespace graspsim::app {
 
 struct RunOptions {
-  std::string out;                  // trace path; "" means "<scenario name>.h5" in the working directory
+  // Trace path; "" means default_trace_name(scenario name) in the working directory. The trace
+  // is written as "<out>.partial", locked, and renamed to `out` when the run ends (output_file.hpp).
+  std::string out;
+  // Files the run reads besides the scenario and its mesh files (which run_scenario adds): a
+  // device's replay recording, the trace replayed. The output may be none of them.
+  std::vector<InputFile> inputs;
   std::size_t block_rows = 0;       // trace rows buffered per loop before a write, = rows per
                                     // chunk; 0: one flush interval of that loop (run.cpp)
   int compression = 0;              // 0 none, 1..9 deflate level
@@ -25,6 +31,7 @@ struct RunOptions {
   // (s); may be empty.
   std::function<void(double simulated, double duration)> progress;
   const std::atomic<bool>* interrupt = nullptr;   // set (by a signal handler) to stop the run
+  const std::atomic<int>* interrupt_signal = nullptr;   // the signal that set it, for the message (0: none)
   // The --set overrides as given (NAME=VALUE, "duration=S" for --duration), for the trace's
   // `overrides` attribute: with the scenario source they reload the same scenario (replay).
   std::vector<std::string> overrides;
@@ -86,7 +93,7 @@ class RecordedPacing {
 };
 
 struct RunResult {
-  std::string trace_path;
+  std::string trace_path;   // where the trace is; "" when nothing was written (the run did not start)
   std::vector<scripting::ExpectationResult> expectations;
   std::vector<std::string> warnings;   // stability warnings: the model's estimates before the run,
                                        // then "t = T s (tick N): ..." for each mode found in it
@@ -95,6 +102,12 @@ struct RunResult {
   double wall = 0.0;        // s
   std::string error;        // non-empty when the run stopped early (Lua error, interrupt, ...)
   bool interrupted = false;
+  // The run could not start (a device that cannot be opened): `error` says why, nothing was
+  // written, and a file already at the output path is as it was.
+  bool not_started = false;
+  // The trace could not be written to its end or not be finished (a full disk): what failed and
+  // what the file keeps (recordings::TraceWriter::close), and where it is.
+  std::string trace_error;
   std::string pacing;        // with a pacer: its summary (overruns of how many ticks, worst lateness)
   std::int64_t overruns = 0; // with a pacer: servo ticks that missed their deadline
   // With a pacer and Lua trajectories: samples the loop held because the script thread's ring
@@ -103,9 +116,12 @@ struct RunResult {
   bool passed() const;      // no error and every expectation met
 };
 
-// Runs the scenario to its end (or to an error), writing the trace. Throws only when the trace
-// cannot be created (recordings::TraceError); every later failure ends the run, closes the trace
-// with status "error: ...", sets every device's force to zero, and is reported in RunResult.
+// Runs the scenario to its end (or to an error), writing the trace. Throws OutputError when the
+// output is an input, a directory, or taken by another run, and recordings::TraceError when the
+// trace cannot be created: nothing is written then. A device that cannot be built ends the run
+// before its first tick with nothing written (RunResult::not_started). Every later failure ends
+// the run, closes the trace with status "error: ...", sets every device's force to zero, and is
+// reported in RunResult; the trace is then renamed to the output path.
 RunResult run_scenario(const scripting::Scenario& scenario, const RunOptions& options);
 
 }  // namespace graspsim::app

@@ -29,8 +29,8 @@ namespace {
 // Exit codes, as documented in --help.
 using graspsim::cli::kExitBadInput;
 using graspsim::cli::kExitFailed;
-using graspsim::cli::kExitInterrupted;
 using graspsim::cli::kExitOk;
+using graspsim::cli::kExitTraceFault;
 
 constexpr const char* kUsage =
     "usage: graspsim run SCENARIO.lua [--out FILE.h5] [--duration S] [--set NAME=VALUE]...\n"
@@ -52,7 +52,8 @@ constexpr const char* kHelp =
     "to an HDF5 trace, and checks the scenario's expectations.\n"
     "\n"
     "options:\n"
-    "  --out FILE.h5        trace file (default: <scenario name>.h5 in this directory)\n"
+    "  --out FILE.h5        trace file (default: <scenario name>.h5 in this directory, any\n"
+    "                       byte of the name outside [A-Za-z0-9_.-] made '_')\n"
     "  --duration S         simulated seconds, overriding the scenario's duration\n"
     "  --set NAME=VALUE     override a scenario value, e.g. --set rates.physics=500,\n"
     "                       --set objects.box.mass=0.5, --set fingers.thumb.stiffness=600,\n"
@@ -84,12 +85,19 @@ constexpr const char* kHelp =
     "physics step to the next, naming its motion, its springs and the rate that holds it.\n"
     "\n"
     "exit status: 0 every expectation held, 1 an expectation failed, 2 bad input (arguments,\n"
-    "scenario, output path, an error in the script while it ran, or a refused unstable\n"
-    "mode), 130 interrupted.\n"
-    "A run that stops early keeps its trace, with root attribute status = \"error: ...\".\n"
-    "A run killed outright leaves status \"running\" and every tick up to its last flush\n"
-    "(at most 0.25 s simulated or 1 s wall old): h5py opens it with swmr=True; after\n"
-    "`graspsim repair TRACE.h5` (see `graspsim repair --help`) every HDF5 tool does.\n"
+    "scenario, output path, a device that cannot be opened, an error in the script while it\n"
+    "ran, or a refused unstable mode), 3 the trace could not be written to its end (a full\n"
+    "disk: it keeps every tick up to its last flush, marked \"error: ...\"), 128 + the signal\n"
+    "when stopped by SIGINT (130), SIGHUP (129) or SIGTERM (143).\n"
+    "The trace is written as FILE.h5.partial, locked (a second run on the same output refuses),\n"
+    "and renamed to FILE.h5 when the run ends, complete or marked: an earlier FILE.h5 is replaced\n"
+    "only then. A run that stops early keeps its trace, with root attribute status = \"error: ...\";\n"
+    "a device that cannot be opened at the start writes nothing. The output may not be an input\n"
+    "(the scenario, a mesh file, a replay recording), nor a link to one.\n"
+    "A run killed outright leaves FILE.h5.partial, status \"running\", with every tick up to\n"
+    "its last flush but one (less than 0.25 s of simulated time lost): h5py opens it with\n"
+    "swmr=True; after `graspsim repair FILE.h5.partial` (see `graspsim repair --help`) every\n"
+    "HDF5 tool does.\n"
     "\n"
     "usage: graspsim replay TRACE.h5 [options]   (graspsim replay --help for more)\n"
     "\n"
@@ -156,7 +164,19 @@ constexpr const char* kCompareHelp =
     "example: graspsim compare golden.h5 new.h5 --rtol 1e-12 --tol 'servo/*=1e-9'\n";
 
 std::atomic<bool> g_interrupt{false};
-extern "C" void on_sigint(int) { g_interrupt.store(true); }
+std::atomic<int> g_signal{0};   // the signal that set g_interrupt
+extern "C" void on_stop_signal(int signal) {
+  g_signal.store(signal);
+  g_interrupt.store(true);
+}
+
+// SIGINT, SIGTERM and SIGHUP end a run at its next check, its trace closed and marked (exit
+// 128 + signal). SIGXFSZ (a file-size limit, `ulimit -f`) is ignored, so that the write fails
+// with EFBIG and ends the run like a full disk instead of killing it.
+void handle_stop_signals() {
+  for (const int s : {SIGINT, SIGTERM, SIGHUP}) std::signal(s, on_stop_signal);
+  std::signal(SIGXFSZ, SIG_IGN);
+}
 
 int bad_input(const std::string& message) {
   std::cerr << "graspsim: " << message << "\n";
@@ -270,9 +290,11 @@ int run_command(const std::vector<std::string>& args) {
 
   graspsim::app::RunOptions options;
   options.out = out;
+  options.inputs = plan.files;
   options.compression = compression;
   options.overrides = load.sets;
   options.interrupt = &g_interrupt;
+  options.interrupt_signal = &g_signal;
   options.record_devices = plan.recorded();
   options.script_alongside = plan.script_alongside;
   // Devices are built when the run starts (run_scenario), so that every one built is released
@@ -296,7 +318,7 @@ int run_command(const std::vector<std::string>& args) {
       std::fflush(stderr);
     };
   }
-  std::signal(SIGINT, on_sigint);
+  handle_stop_signals();
   options.refuse_unstable = refuse_unstable;
   // Each stability warning as it is found (the progress line, if any, is cleared first).
   options.on_warning = [tty](const std::string& w) {
@@ -307,10 +329,16 @@ int run_command(const std::vector<std::string>& args) {
   graspsim::app::RunResult result;
   try {
     result = graspsim::app::run_scenario(*scenario, options);
+  } catch (const graspsim::app::OutputError& e) {
+    return bad_input(e.what());
   } catch (const graspsim::recordings::TraceError& e) {
     return bad_input(std::string("cannot write the trace: ") + e.what());
   }
   if (tty) std::fprintf(stderr, "\r%60s\r", "");
+  if (result.not_started) {
+    return bad_input("the run could not start: " + result.error +
+                     "\n  (nothing was written; a file already at the output path is as it was)");
+  }
 
   const auto& model = scenario->model();
   std::error_code ec;
@@ -330,12 +358,15 @@ int run_command(const std::vector<std::string>& args) {
                   scenario->jitter().amplitude, static_cast<unsigned long long>(scenario->jitter().seed));
     if (pacer) std::printf("  pacing      %s%s\n", result.pacing.c_str(), options.realtime ? ", SCHED_FIFO" : "");
   }
-  if (!result.error.empty()) {
+  if (!result.trace_error.empty()) {
+    std::fprintf(stderr, "graspsim: the trace could not be written to its end: %s\n", result.trace_error.c_str());
+  } else if (!result.error.empty()) {
     std::fprintf(stderr, "graspsim: the run stopped early: %s\n  (the trace keeps every tick up to there)\n",
                  result.error.c_str());
   }
   const int failed = graspsim::cli::print_expectations(result, quiet);
-  if (result.interrupted) return kExitInterrupted;
+  if (!result.trace_error.empty()) return kExitTraceFault;
+  if (result.interrupted) return graspsim::cli::exit_interrupted(&g_signal);
   if (!result.error.empty()) return kExitBadInput;
   if (!quiet) {
     if (failed) std::printf("  result      %d of %zu expectations failed\n", failed, result.expectations.size());
@@ -439,8 +470,8 @@ int main(int argc, char** argv) {
   }
   if (command == "run") return run_command({args.begin() + 1, args.end()});
   if (command == "replay") {
-    std::signal(SIGINT, on_sigint);
-    return graspsim::cli::replay_command({args.begin() + 1, args.end()}, &g_interrupt);
+    handle_stop_signals();
+    return graspsim::cli::replay_command({args.begin() + 1, args.end()}, &g_interrupt, &g_signal);
   }
   if (command == "repair") return graspsim::cli::repair_command({args.begin() + 1, args.end()});
   if (command == "compare") return compare_command({args.begin() + 1, args.end()});

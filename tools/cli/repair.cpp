@@ -4,6 +4,7 @@
 
 #include <iostream>
 
+#include "app/output_file.hpp"
 #include "graspsim/recordings/trace_repair.hpp"
 #include "graspsim/recordings/trace_writer.hpp"
 
@@ -17,7 +18,8 @@ constexpr const char* kRepairHelp =
     "the HDF5 file's SWMR/open status flags and extends its end of allocation past the end of\n"
     "the file (like `h5clear -s --increment`, which never truncates), and sets status to\n"
     "\"cut: repaired\". The file keeps every tick up to the run's last flush. A trace that was not\n"
-    "cut is left untouched. Never repair a trace a run is still writing.\n"
+    "cut is left untouched. A trace a run is still writing (locked: FILE.h5.partial while the\n"
+    "run goes on) is refused.\n"
     "\n"
     "exit status: 0 repaired or nothing to repair, 2 bad input (not a graspsim trace, or it\n"
     "cannot be repaired).\n";
@@ -31,6 +33,11 @@ int repair_command(const std::vector<std::string>& args) {
   }
   if (args.size() != 1 || args[0].empty() || args[0].front() == '-') {
     std::cerr << "graspsim: repair needs exactly one trace file\n" << kRepairHelp;
+    return 2;
+  }
+  if (app::locked_by_a_run(args[0])) {
+    std::cerr << "graspsim: '" << args[0] << "' is being written by a graspsim run (it is locked): "
+              << "it is not cut; repair it only if that run is killed\n";
     return 2;
   }
   try {

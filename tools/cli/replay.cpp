@@ -48,7 +48,10 @@ constexpr const char* kReplayHelp =
     "exit status: 0 reproduced (with --set: ran) and every expectation held, 1 an expectation\n"
     "failed or a replay without --set differs from the recording, 2 bad input (not a graspsim\n"
     "trace, a schema 1 trace without device inputs, a scenario finger the trace lacks, rates\n"
-    "changed by --set, a scenario that does not load, an unwritable output), 130 interrupted.\n";
+    "changed by --set, a scenario that does not load, an unwritable output), 3 the new trace\n"
+    "could not be written to its end (a full disk), 128 + the signal when stopped by SIGINT,\n"
+    "SIGHUP or SIGTERM. The new trace is written, locked and renamed as `graspsim run` does\n"
+    "(graspsim --help).\n";
 
 int bad_input(const std::string& message) {
   std::cerr << "graspsim: " << message << "\n";
@@ -61,7 +64,8 @@ std::string default_out(const std::string& trace) {
 
 }  // namespace
 
-int replay_command(const std::vector<std::string>& args, const std::atomic<bool>* interrupt) {
+int replay_command(const std::vector<std::string>& args, const std::atomic<bool>* interrupt,
+                   const std::atomic<int>* signal) {
   std::string trace, out;
   app::ReplayOptions replay;
   int compression = 0;
@@ -116,12 +120,17 @@ int replay_command(const std::vector<std::string>& args, const std::atomic<bool>
   app::RunOptions options = plan.run_options(out);
   options.compression = compression;
   options.interrupt = interrupt;
+  options.interrupt_signal = signal;
+  options.inputs.push_back({trace, "the trace replayed"});
   app::RunResult result;
   try {
     result = app::run_scenario(*plan.scenario, options);
+  } catch (const app::OutputError& e) {
+    return bad_input(e.what());
   } catch (const recordings::TraceError& e) {
     return bad_input(std::string("cannot write the trace: ") + e.what());
   }
+  if (result.not_started) return bad_input("the replay could not start: " + result.error + " (nothing was written)");
 
   const auto& scenario = *plan.scenario;
   if (!quiet) {
@@ -137,7 +146,9 @@ int replay_command(const std::vector<std::string>& args, const std::atomic<bool>
                 static_cast<long long>(result.physics_ticks));
     std::printf("  trace       %s\n", result.trace_path.c_str());
   }
-  if (!result.error.empty()) {
+  if (!result.trace_error.empty()) {
+    std::fprintf(stderr, "graspsim: the trace could not be written to its end: %s\n", result.trace_error.c_str());
+  } else if (!result.error.empty()) {
     std::fprintf(stderr, "graspsim: the replay stopped early: %s\n  (the trace keeps every tick up to there)\n",
                  result.error.c_str());
   }
@@ -173,7 +184,8 @@ int replay_command(const std::vector<std::string>& args, const std::atomic<bool>
   }
 
   const int failed = print_expectations(result, quiet);
-  if (result.interrupted) return kExitInterrupted;
+  if (!result.trace_error.empty()) return kExitTraceFault;
+  if (result.interrupted) return exit_interrupted(signal);
   if (!result.error.empty()) return kExitBadInput;
   if (!plan.what_if && !reproduced) return kExitFailed;
   return failed ? kExitFailed : kExitOk;

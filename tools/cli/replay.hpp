@@ -10,7 +10,9 @@ namespace graspsim::cli {
 
 // args: what follows "replay". Exit codes: 0 reproduced (or, with --set, ran) and every
 // expectation held, 1 an expectation failed or a plain replay differs from the recording,
-// 2 bad input, 130 interrupted (`interrupt` set).
-int replay_command(const std::vector<std::string>& args, const std::atomic<bool>* interrupt);
+// 2 bad input, 3 the trace could not be written to its end, 128 + `signal` interrupted
+// (`interrupt` set).
+int replay_command(const std::vector<std::string>& args, const std::atomic<bool>* interrupt,
+                   const std::atomic<int>* signal = nullptr);
 
 }  // namespace graspsim::cli

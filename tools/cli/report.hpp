@@ -1,6 +1,7 @@
 // What the run and replay commands share: exit codes and the expectations report.
 #pragma once
 
+#include <atomic>
 #include <cstdio>
 
 #include "app/run.hpp"
@@ -10,7 +11,15 @@ namespace graspsim::cli {
 constexpr int kExitOk = 0;            // every expectation held
 constexpr int kExitFailed = 1;        // an expectation failed
 constexpr int kExitBadInput = 2;      // bad input: arguments, scenario, output path, script error
-constexpr int kExitInterrupted = 130; // Ctrl-C (128 + SIGINT)
+constexpr int kExitTraceFault = 3;    // the trace could not be written to its end (a full disk):
+                                      // it keeps every tick up to its last flush, marked
+constexpr int kExitInterrupted = 130; // Ctrl-C (128 + SIGINT); SIGTERM 143, SIGHUP 129
+
+// 128 + the signal that stopped the run (SIGINT if none is known).
+inline int exit_interrupted(const std::atomic<int>* signal) {
+  const int s = signal ? signal->load() : 0;
+  return s > 0 ? 128 + s : kExitInterrupted;
+}
 
 // Prints the expectations of a run (only the failed ones when quiet); returns how many failed.
 inline int print_expectations(const app::RunResult& result, bool quiet) {

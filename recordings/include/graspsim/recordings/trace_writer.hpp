@@ -84,6 +84,11 @@ struct TraceOptions {
   // thread that appends rows only fills memory (it waits only when the writer is 4 blocks per
   // table behind). Errors surface at a later call. The file is the same either way.
   bool background = false;
+  // Room held on the file's file system (an unlinked, preallocated file beside it) and given
+  // back just before close(), so that a trace cut by a full disk can still be closed and marked
+  // (recordings/README.md "A full disk"). Halved down to 16 KiB where there is less room; 0:
+  // none.
+  std::size_t reserve_bytes = 128 * 1024;   // bytes
 };
 
 class TraceWriter {
@@ -119,15 +124,28 @@ class TraceWriter {
     set_attribute(name, static_cast<std::int64_t>(value));
   }
   // Hands every table's buffered rows to the writer, then an H5Fflush (done by the time this
-  // returns without TraceOptions::background; with it, queued: see wait()).
-  void flush();
+  // returns without TraceOptions::background; with it, queued: see wait()). Returns the flush's
+  // ticket for wait(ticket).
+  std::uint64_t flush();
   // Waits until everything handed to the writer is on disk; rethrows a failure of the writer.
   void wait();
+  // Waits until the flush that returned `ticket`, and everything handed over before it, is on
+  // disk (later blocks may still be queued); rethrows a failure of the writer. A runner that
+  // waits for flush k - 1 before it hands over flush k keeps the writer at most one flush
+  // interval behind: a process killed at any moment loses at most two intervals of rows.
+  void wait(std::uint64_t ticket);
   // Flushes, closes the file, reopens it without SWMR, writes the kept root attributes and
-  // root string attribute "status" (e.g. "complete" or "error: <message>") and closes it. Idempotent: later calls do nothing. If the flush fails the status
-  // written is "error: <flush failure>", the file is still closed, and TraceError is thrown.
+  // root string attribute "status" (e.g. "complete" or "error: <message>") and closes it.
+  // Idempotent: later calls do nothing. If writing failed (a full disk), every table is cut
+  // back to the rows of the last successful flush (rows after it may be only partly on disk),
+  // the status written is "error: <failure>; kept up to the last flush: <table> <rows>, ...",
+  // the file is still closed, and TraceError is thrown with that text. If even the status cannot
+  // be written, the message says so (the file then says "running": `graspsim repair`).
   void close(const std::string& status);
   bool is_closed() const;
+  // Closed with its final status in the file ("complete" or "error: ..."): a file that may
+  // replace an earlier one. False while open, and when close() could not write the status.
+  bool marked() const;
   const std::string& path() const;
 
  private:

@@ -121,6 +121,9 @@ class Scenario {
 
   const std::string& path() const { return path_; }
   const std::string& source() const { return source_; }   // the file's text, for the trace
+  // Every file the scenario read besides its own (mesh files), as opened: a run's output may be
+  // none of them.
+  const std::vector<std::string>& files() const { return files_; }
   const std::string& name() const { return name_; }
   const std::string& description() const { return description_; }
   const Model& model() const { return model_; }
@@ -178,6 +181,7 @@ class Scenario {
   // Moves the trajectories by the jitter's offsets and keeps them (load_source, after conversion).
   void apply_jitter(const Jitter& jitter);
   std::string path_, source_, name_, description_;
+  std::vector<std::string> files_;
   Model model_;
   double duration_ = 0.0;
   std::uint64_t seed_ = 0;
