@@ -375,10 +375,11 @@ TEST_CASE("graspsim run without lockstep against a lockstep device_server exits 
 // tick (the first force datagram, tick 0's), not at the hello, which comes about half a second
 // earlier while the run sets up: otherwise the first tick already received sample 255 or later,
 // and the replayed thumb led the scripted index for the whole lift (4 of 5 expectations failed).
-// Law: the lift is the same motion as its recording only if tick n gets the recorded row n: tick 0
-// reads sample 0 (the hello's answer), and afterwards the stream lags by the time a sample takes
-// to cross (it is sent (n - 1) / rate after tick 0's force, and read at about n / rate): one tick
-// at most while the loop keeps its deadlines. Real time, 4 s; the run is paced (SCHED_FIFO as root).
+// Law: the lift is its recorded motion only if tick n gets about row n. Tick 0 reads sample 0
+// (the hello's answer); afterwards the stream trails the run by the time the server took to see
+// tick 0's force (scheduling, well under 10 ms = 30 ticks; measured 0.3 to 1.3 ms) and is never
+// ahead of it, where a clock started at the hello leads by the whole set-up. Real time, 4 s; the
+// run is paced (SCHED_FIFO as root).
 TEST_CASE("a streamed device_server replay starts its clock at the run's first tick: the lift meets all 5 "
           "expectations", "[e2e][udp][devices][streaming]") {
   const std::string cli = GRASPSIM_CLI;
@@ -398,10 +399,17 @@ TEST_CASE("a streamed device_server replay starts its clock at the run's first t
   const auto sequence = graspsim::recordings::read_dataset(session, "/devices/thumb/sequence").values;
   REQUIRE(sequence.size() == 12000);
   CHECK(sequence[0] == 0.0);   // tick 0 reads sample 0: the clock did not run before the run
-  std::size_t within_one = 0;
-  for (std::size_t n = 0; n < sequence.size(); ++n) within_one += (n - sequence[n] == 0.0 || n - sequence[n] == 1.0);
-  INFO("ticks whose sample is sample n or n - 1: " << within_one << " of 12000");
-  CHECK(within_one >= 11000);   // measured 11966 (overruns of a loaded machine make the rest)
+  std::vector<double> lag(sequence.size());   // ticks: how far the stream trails the run
+  std::size_t ahead = 0;
+  for (std::size_t n = 0; n < sequence.size(); ++n) {
+    lag[n] = static_cast<double>(n) - sequence[n];
+    ahead += lag[n] < 0.0;
+  }
+  std::nth_element(lag.begin(), lag.begin() + 6000, lag.end());
+  INFO("median lag " << lag[6000] << " ticks; ticks whose sample was ahead of the run: " << ahead);
+  CHECK(lag[6000] >= 0.0);
+  CHECK(lag[6000] <= 30.0);
+  CHECK(ahead <= 120);   // 1 %: an overrun tick may read a later sample; none measured
   int status = -1;
   server.finish(&status);
   CHECK(status == 0);

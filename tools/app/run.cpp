@@ -20,6 +20,7 @@
 #include "graspsim/engine/state_hash.hpp"
 #include "graspsim/hw/mapped_device.hpp"
 #include "graspsim/hw/sample_clock.hpp"
+#include "graspsim/hw/sample_check.hpp"
 #include "graspsim/hw/sample_counter.hpp"
 #include "graspsim/hw/scripted_finger.hpp"
 #include "graspsim/recordings/trace_recorder.hpp"
@@ -256,6 +257,9 @@ RunResult run_scenario(const scripting::Scenario& scenario, const RunOptions& op
       }
     }
     writer.set_attribute("devices", device_list.str());
+    // Every sample is checked (finite, inside the device's workspace) before the engine sees it.
+    std::vector<hw::SampleCheck> checks;
+    for (std::size_t f = 0; f < devices.size(); ++f) checks.emplace_back(*devices[f], model.fingers[f].name);
     std::vector<hw::DeviceSample> samples(devices.size());   // this tick's, as read (world)
     // The scripts of fingers whose device does not run them (RunOptions::script_alongside).
     std::vector<std::unique_ptr<hw::Trajectory>> side_scripts(devices.size());
@@ -338,6 +342,7 @@ RunResult run_scenario(const scripting::Scenario& scenario, const RunOptions& op
       for (std::size_t f = 0; f < devices.size(); ++f) {
         if (side_scripts[f]) side_scripts[f]->sample(t);   // for what the script keeps; output unused
         samples[f] = devices[f]->read(n, t);
+        checks[f].check(samples[f], n, t);   // throws: the run stops with the device's fault
         input.fingers[f].hip = samples[f].position;
         input.fingers[f].gimbal = samples[f].gimbal;
       }
