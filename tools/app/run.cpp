@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <memory>
 #include <numeric>
+#include <new>
 #include <optional>
 #include <sstream>
 #include <thread>
@@ -77,6 +78,8 @@ constexpr double kFlushSimulated = 0.25;   // s, simulated
 constexpr double kFlushWall = 0.9;         // s, wall (under 1 s, with the check interval's slack)
 constexpr std::int64_t kWallCheckTicks = 64;
 
+}  // namespace
+
 // Servo ticks between flushes on simulated time: the largest whole number of physics (and
 // haptic) periods within kFlushSimulated, so that every flush interval holds the same number of
 // rows of every loop and each table's chunk can be exactly one interval (each chunk is then
@@ -89,6 +92,8 @@ std::int64_t flush_interval_ticks(const Model& model) {
   const std::int64_t period = std::lcm(d.haptic, d.physics);
   return period <= limit ? limit / period * period : limit;
 }
+
+namespace {
 
 constexpr std::size_t kNoColumn = static_cast<std::size_t>(-1);
 
@@ -470,6 +475,11 @@ RunResult run_scenario(const scripting::Scenario& scenario, const RunOptions& op
       else initial = snapshot(sim, record, slip);
     }
     check_due(run_ticks);
+  } catch (const std::bad_alloc&) {
+    // The estimate before the run (run_budget.hpp) leaves room; this is the machine running out
+    // anyway (another process took it), said as such rather than as a bare "std::bad_alloc".
+    result.error = "out of memory after " + std::to_string(result.servo_ticks) +
+                   " servo ticks: the machine could not give the run the memory it asked for";
   } catch (const std::exception& e) {
     result.error = e.what();
   }
