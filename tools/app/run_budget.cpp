@@ -18,7 +18,7 @@ namespace {
 // One /devices/<finger> row as run.cpp's device_columns declares it: tick and buttons (int64),
 // time, device_time, position, gimbal and force (11 float64) and overrun (int8), 14 values in
 // 105 bytes; the counters sequence and new_samples (int64) add 2 values and 16 bytes.
-// tests/e2e/test_input_catalogue.cpp checks it against a written table.
+// tests/e2e/test_run_budget.cpp checks it against a written table.
 recordings::RowSize device_row(bool counters) {
   return counters ? recordings::RowSize{16, 121} : recordings::RowSize{14, 105};
 }
