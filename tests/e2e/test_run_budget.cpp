@@ -27,8 +27,11 @@ scripting::Scenario lift(const std::vector<std::string>& sets) {
   return scripting::Scenario::load(kLift, load);
 }
 
-// Bytes of data the file allocates for a table (its chunks), and the bytes of one chunk.
-std::pair<double, double> storage(const std::string& file, const std::string& table) {
+// What the file holds for a table: the bytes its chunks take, one chunk's bytes, one row's bytes.
+struct Stored {
+  double storage = 0.0, chunk = 0.0, row = 0.0;   // bytes
+};
+Stored stored(const std::string& file, const std::string& table) {
   const hid_t f = H5Fopen(file.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
   REQUIRE(f >= 0);
   const hid_t d = H5Dopen2(f, table.c_str(), H5P_DEFAULT);
@@ -37,13 +40,13 @@ std::pair<double, double> storage(const std::string& file, const std::string& ta
   const hid_t plist = H5Dget_create_plist(d);
   hsize_t chunk[1] = {0};
   REQUIRE(H5Pget_chunk(plist, 1, chunk) == 1);
-  const double stored = static_cast<double>(H5Dget_storage_size(d));
-  const double chunk_bytes = static_cast<double>(chunk[0] * H5Tget_size(type));
+  Stored out{static_cast<double>(H5Dget_storage_size(d)), static_cast<double>(chunk[0] * H5Tget_size(type)),
+             static_cast<double>(H5Tget_size(type))};
   H5Pclose(plist);
   H5Tclose(type);
   H5Dclose(d);
   H5Fclose(f);
-  return {stored, chunk_bytes};
+  return out;
 }
 
 std::vector<hw::Vec3> rows(const recordings::Dataset& d) {
@@ -55,9 +58,11 @@ std::vector<hw::Vec3> rows(const recordings::Dataset& d) {
 }  // namespace
 
 // The disk estimate is the rows' stored bytes: an uncompressed table allocates whole chunks, so
-// its storage S holds the estimate E with at most one chunk C to spare: E <= S < E + C, per
-// table. Swept over three durations of the lift (1.5 s, 2.34 s: a partly filled last chunk, 4 s), and with one finger on a replayed device (its
-// /devices table, 121-byte rows with the counters: run_budget.cpp's count of run.cpp's columns).
+// its storage S holds the estimate E with at most one chunk C to spare: E <= S < E + C, per table,
+// and each table's row is the stored compound type's size exactly. Swept over three durations of
+// the lift (1.5 s, 2.34 s: a partly filled last chunk, 4 s), and with one finger on a replayed
+// device (its /devices table, 121-byte rows with the counters: run_budget.cpp's count of
+// run.cpp's columns).
 TEST_CASE("the disk estimate is every table's rows at their stored size, within one chunk of the file's "
           "storage", "[e2e][run_budget]") {
   const scripting::Scenario recorded = lift({});
@@ -84,17 +89,20 @@ TEST_CASE("the disk estimate is every table's rows at their stored size, within 
       INFO(result.error);
       REQUIRE(result.error.empty());
       CHECK(need.servo_ticks == result.servo_ticks);
-      double stored = 0.0, chunks = 0.0;
-      std::vector<std::string> tables = {"/servo", "/haptic", "/physics"};
-      if (device) tables.push_back("/devices/thumb");
-      for (const std::string& t : tables) {
-        const auto [s, c] = storage(options.out, t);
-        stored += s;
-        chunks += c;
+      CHECK(need.tables.size() == (device ? 4u : 3u));
+      double total = 0.0;
+      for (const app::TableFootprint& t : need.tables) {
+        const Stored s = stored(options.out, t.name);
+        const double estimate = t.rows * static_cast<double>(t.bytes);
+        INFO(t.name << ": estimate " << estimate << " bytes, stored " << s.storage << ", chunk " << s.chunk);
+        CHECK(static_cast<double>(t.bytes) == s.row);
+        CHECK(estimate <= s.storage);
+        CHECK(s.storage < estimate + s.chunk);
+        total += estimate;
       }
-      INFO("estimate " << need.disk << " bytes, stored " << stored << ", chunks " << chunks);
-      CHECK(need.disk <= stored);
-      CHECK(stored < need.disk + chunks);
+      CHECK(need.disk == total);
+      if (device) CHECK(need.tables.back().name == "/devices/thumb");
+      if (device) CHECK(need.tables.back().bytes == 121u);
     }
   }
 }

@@ -32,13 +32,6 @@ std::string bytes_text(double bytes) {
   return buf;
 }
 
-struct Table {
-  const char* name;
-  recordings::RowSize row;
-  double block_rows;   // rows per writer block
-  double rows;         // rows in the run
-};
-
 }  // namespace
 
 RunFootprint estimate_footprint(const scripting::Scenario& scenario, const RunOptions& options) {
@@ -54,24 +47,26 @@ RunFootprint estimate_footprint(const scripting::Scenario& scenario, const RunOp
     return options.block_rows > 0 ? static_cast<double>(options.block_rows) : std::ceil(flush / divisor);
   };
   const recordings::TraceRecorder::Rows rows = recordings::TraceRecorder::row_sizes(model);
-  std::vector<Table> tables = {
-      {"/servo", rows.servo, block(1), run},
-      {"/haptic", rows.haptic, block(static_cast<double>(d.haptic)), std::ceil(run / static_cast<double>(d.haptic))},
-      {"/physics", rows.physics, block(static_cast<double>(d.physics)), std::ceil(run / static_cast<double>(d.physics))}};
-  for (bool recorded : options.record_devices)
-    if (recorded) tables.push_back({"/devices/<finger>", device_row(options.device_counters), block(1), run});
+  const auto table = [&](std::string name, recordings::RowSize row, double divisor) {
+    out.tables.push_back({std::move(name), row.values, row.bytes, block(divisor), std::ceil(run / divisor)});
+  };
+  table("/servo", rows.servo, 1.0);
+  table("/haptic", rows.haptic, static_cast<double>(d.haptic));
+  table("/physics", rows.physics, static_cast<double>(d.physics));
+  for (std::size_t f = 0; f < options.record_devices.size() && f < model.fingers.size(); ++f)
+    if (options.record_devices[f]) table("/devices/" + model.fingers[f].name, device_row(options.device_counters), 1.0);
   const double pool = options.background_writer ? 4.0 : 1.0;   // TraceTable's blocks (trace_writer.cpp)
   double largest = -1.0;
-  for (const Table& t : tables) {
-    const double memory = pool * t.block_rows * static_cast<double>(t.row.values) * 8.0 + t.block_rows * static_cast<double>(t.row.bytes);
+  for (const TableFootprint& t : out.tables) {
+    const double memory = pool * t.block_rows * static_cast<double>(t.values) * 8.0 + t.block_rows * static_cast<double>(t.bytes);
     out.memory += memory;
-    out.disk += t.rows * static_cast<double>(t.row.bytes);
+    out.disk += t.rows * static_cast<double>(t.bytes);
     if (memory > largest) {
       largest = memory;
       std::ostringstream detail;
-      detail << t.name << ": " << pool << " blocks of " << static_cast<long long>(t.block_rows) << " rows of "
-             << t.row.values << " values, one flush interval (" << flush / model.rates.servo << " s) at rates.servo = "
-             << model.rates.servo << " Hz";
+      detail << t.name << ": " << pool << " blocks of " << static_cast<long long>(t.block_rows) << " rows of " << t.values
+             << " values, one flush interval (" << flush / model.rates.servo << " s) at rates.servo = " << model.rates.servo
+             << " Hz";
       out.memory_detail = detail.str();
     }
   }

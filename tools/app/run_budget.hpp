@@ -7,13 +7,24 @@
 
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "app/run.hpp"
 #include "graspsim/scripting/scenario.hpp"
 
 namespace graspsim::app {
 
+// One table of the trace, as the estimate counts it.
+struct TableFootprint {
+  std::string name;              // "/servo", "/haptic", "/physics", "/devices/<finger>"
+  std::size_t values = 0;        // doubles per row in the writer's blocks
+  std::size_t bytes = 0;         // bytes per stored row
+  double block_rows = 0.0;       // rows per writer block (and chunk)
+  double rows = 0.0;             // rows in the run
+};
+
 struct RunFootprint {
+  std::vector<TableFootprint> tables;
   std::int64_t servo_ticks = 0;   // ticks the run will take
   double memory = 0.0;            // bytes: every table's writer blocks and packing buffer at once
   double disk = 0.0;              // bytes: the trace's rows, uncompressed (attributes not counted)
