@@ -13,6 +13,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <set>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -30,15 +31,17 @@ namespace {
 const std::string kCli = GRASPSIM_CLI;
 const std::string kSource = GRASPSIM_SOURCE_DIR;
 const std::string kLift = kSource + "/scenarios/two_finger_lift.lua";
-const std::string kDir = std::string(GRASPSIM_TEST_TMP) + "/catalogue";
+// Each case works in its own directory (ctest runs cases as parallel processes).
+std::string g_dir = std::string(GRASPSIM_TEST_TMP) + "/catalogue";
+void use_dir(const std::string& name) {
+  g_dir = std::string(GRASPSIM_TEST_TMP) + "/catalogue_" + name;
+  fs::create_directories(g_dir);
+}
 
 // The CLI under a 60 s timeout (a hang: 124; a signal: 128 + its number).
 Outcome cli(const std::string& args) { return graspsim::test::shell("timeout 60 " + kCli + " " + args); }
 
-std::string path(const std::string& name) {
-  fs::create_directories(kDir);
-  return kDir + "/" + name;
-}
+std::string path(const std::string& name) { return g_dir + "/" + name; }
 
 std::string write(const std::string& name, const std::string& text) {
   const std::string p = path(name);
@@ -62,14 +65,16 @@ std::string fresh(const std::string& name) {
 }
 
 // A real trace: the lift's first 1.5 s (its first expectation is due then; the others are not
-// checked, exit 1), made once per test process.
-const std::string& lift_trace() {
-  static const std::string trace = [] {
-    const std::string p = fresh("lift.h5");
+// checked, exit 1), made once in the case's directory.
+std::string lift_trace() {
+  static std::set<std::string> made;   // directories whose trace this process made
+  const std::string p = path("lift.h5");
+  if (made.insert(g_dir).second) {
+    std::error_code ec;
+    fs::remove(p, ec);
     REQUIRE(cli("run " + kLift + " --quiet --duration 1.5 --out " + p).status == 1);
-    return p;
-  }();
-  return trace;
+  }
+  return p;
 }
 
 std::string copy_of_lift(const std::string& name) {
@@ -93,6 +98,7 @@ std::string status_attribute(const std::string& trace) {
 // what it is, and no trace written; so are a directory and a file over 64 MiB (sparse: no disk).
 TEST_CASE("catalogue: mesh files that are not regular files, or too large, exit 2 naming the file",
           "[e2e][catalogue][mesh_file]") {
+  use_dir("mesh");
   std::error_code ec;
   fs::remove(path("zero.stl"), ec);
   fs::create_symlink("/dev/zero", path("zero.stl"));
@@ -116,7 +122,7 @@ TEST_CASE("catalogue: mesh files that are not regular files, or too large, exit 
     const Outcome o = cli("run " + scenario + " --out " + out);
     INFO(o.output);
     CHECK(o.status == 2);
-    CHECK_THAT(o.output, Contains("objects[1] 'm': file: " + kDir + "/" + c.says));
+    CHECK_THAT(o.output, Contains("objects[1] 'm': file: " + g_dir + "/" + c.says));
     CHECK_FALSE(fs::exists(out));
   }
   fs::remove(path("huge.stl"));
@@ -128,6 +134,7 @@ TEST_CASE("catalogue: mesh files that are not regular files, or too large, exit 
 // every command that reads a trace (compare, replay, repair, run --device f=replay:).
 TEST_CASE("catalogue: a trace with a 2^36-row extent, a FIFO or a device as a trace exit 2 from every reader",
           "[e2e][catalogue][trace]") {
+  use_dir("extent");
   const std::string big = copy_of_lift("extent.h5");
   {
     const hid_t f = H5Fopen(big.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
@@ -170,6 +177,7 @@ TEST_CASE("catalogue: a trace with a 2^36-row extent, a FIFO or a device as a tr
 // exit 2 from compare, replay and repair, at once (repair reads no string of the damaged heap).
 TEST_CASE("catalogue: a damaged string heap and a damaged superblock checksum exit 2, never a signal or a hang",
           "[e2e][catalogue][trace]") {
+  use_dir("damaged");
   const std::string heap = copy_of_lift("heap.h5");
   {
     std::string bytes = read_bytes(heap);
@@ -218,6 +226,7 @@ TEST_CASE("catalogue: a damaged string heap and a damaged superblock checksum ex
 // read). About 20 s.
 TEST_CASE("catalogue: 300 seeded one-byte mutants of a trace's metadata: compare, replay and repair end with 0, "
           "1 or 2", "[e2e][catalogue][trace][mutants]") {
+  use_dir("mutants");
   const std::string original = read_bytes(lift_trace());
   // The raw data of the three tables, from their chunks' addresses.
   std::vector<std::pair<std::uint64_t, std::uint64_t>> data;   // (offset, size), bytes
@@ -291,6 +300,7 @@ TEST_CASE("catalogue: 300 seeded one-byte mutants of a trace's metadata: compare
 // from `run --device thumb=replay:` and from `graspsim replay`.
 TEST_CASE("catalogue: a replayed HIP that is NaN or outside the workspace stops the run at its tick, exit 2, "
           "trace kept and marked", "[e2e][catalogue][samples]") {
+  use_dir("samples");
   const std::string nan = copy_of_lift("nan_hip.h5");
   graspsim::test::set_element(nan, "/servo/fingers/thumb/hip", 1500, 0, std::nan(""));
   const std::string far = copy_of_lift("far_hip.h5");
@@ -324,6 +334,7 @@ TEST_CASE("catalogue: a replayed HIP that is NaN or outside the workspace stops 
 // of trace. Exit 2, nothing written.
 TEST_CASE("catalogue: runs over the duration or rate ceiling, or too big for the disk, exit 2 naming the figure, "
           "nothing written", "[e2e][catalogue][size]") {
+  use_dir("size");
   std::string fingers;
   for (int i = 1; i <= 20; ++i)
     fingers += "{ name = 'f" + std::to_string(i) + "', stiffness = 100, trajectory = { { t = 0, p = { " +
@@ -353,6 +364,7 @@ TEST_CASE("catalogue: runs over the duration or rate ceiling, or too big for the
 // kept up to there and marked. string.rep("", 1e15) looped in C the same way.
 TEST_CASE("catalogue: a backtracking pattern or an endless string.rep at load or mid-run stops at the budget, exit 2",
           "[e2e][catalogue][lua]") {
+  use_dir("lua");
   const std::string box = "objects = { { name = 'box', size = { 0.1, 0.1, 0.1 }, mass = 1, position = { 0, 0, 1 } } }";
   const std::string pattern = "string.rep('a', 20000):find(string.rep('.-', 8) .. 'b')";
   const std::string at_load = write("pattern_load.lua", "local r = " + pattern + "\nreturn { duration = 1, " + box + " }\n");
