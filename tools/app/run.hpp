@@ -84,6 +84,10 @@ struct RunOptions {
   bool wait_for_script = false;
 };
 
+// Servo ticks between two flushes of the trace on simulated time (about 0.25 s): also every
+// table's block and chunk, in rows of its loop (run.cpp; run_budget.hpp counts on it).
+std::int64_t flush_interval_ticks(const Model& model);
+
 // A device whose samples carry their recorded overrun flag (a replay of /devices rows): the
 // run loop records that flag instead of its own pacing's, so a replay rewrites the same rows.
 class RecordedPacing {

@@ -16,6 +16,7 @@
 #include "app/devices.hpp"
 #include "app/pacer.hpp"
 #include "app/run.hpp"
+#include "app/run_budget.hpp"
 #include "cli/repair.hpp"
 #include "cli/replay.hpp"
 #include "cli/report.hpp"
@@ -325,6 +326,13 @@ int run_command(const std::vector<std::string>& args) {
     if (tty) std::fprintf(stderr, "\r%60s\r", "");
     std::cerr << "graspsim: warning: " << w << "\n";
   };
+
+  // A run that will not fit (memory for its trace buffers, disk for its trace) is refused
+  // before anything is written (README.md "Run length and rates").
+  std::string size_warning;
+  const std::string too_big = graspsim::app::check_run_fits(*scenario, options, &size_warning);
+  if (!too_big.empty()) return bad_input(too_big);
+  if (!size_warning.empty()) std::cerr << "graspsim: warning: " << size_warning << "\n";
 
   graspsim::app::RunResult result;
   try {
