@@ -145,7 +145,10 @@ TEST_CASE("catalogue: a full disk ends the run with exit 3 and a marked trace up
     const std::string beside = disk.directory() + "/beside.txt";
     write_file(beside, "an earlier file on the same disk\n");
     const std::string trace = disk.directory() + "/x.h5";
-    const Outcome o = cli_in(disk.directory(), "run " + kLift + " --duration 100 --quiet --out x.h5");
+    // Compressed, so that the run starts: its size is not known ahead, and the run budget only
+    // warns (uncompressed, a trace that cannot fit the disk is refused before it starts, exit 2:
+    // tests/e2e/test_input_catalogue.cpp). 1000 s compressed is tens of MB: every size fills.
+    const Outcome o = cli_in(disk.directory(), "run " + kLift + " --duration 1000 --compress 1 --quiet --out x.h5");
     INFO("tmpfs of " << size << " bytes\n" << o.output);
     CHECK(o.status == kExitTraceFault);
     CHECK_THAT(o.output, Catch::Contains("the trace could not be written to its end") &&

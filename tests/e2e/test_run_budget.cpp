@@ -108,23 +108,23 @@ TEST_CASE("the disk estimate is every table's rows at their stored size, within 
 }
 
 // The memory estimate, derived by hand for the lift at 3000 / 500 / 50 Hz: a flush interval is
-// 720 servo ticks (the whole physics periods within 0.25 s), so blocks of 720 / 120 / 12 rows of
+// 360 servo ticks (the whole physics periods within 0.12 s), so blocks of 360 / 60 / 6 rows of
 // 26 / 30 / 27 doubles, held 4 times with the writer thread, plus one packed block of
 // 208 / 218 / 208 bytes a row:
-//   4 x 8 x (720 x 26 + 120 x 30 + 12 x 27) + 720 x 208 + 120 x 218 + 12 x 208 = 903,024 bytes.
-// At 30000 / 5000 / 50 Hz the interval is 7200 ticks: the servo and haptic blocks 10 times
-// longer, the physics block the same 12 rows:
-//   4 x 8 x (7200 x 26 + 1200 x 30 + 12 x 27) + 7200 x 208 + 1200 x 218 + 12 x 208 = 8,914,464.
+//   4 x 8 x (360 x 26 + 60 x 30 + 6 x 27) + 360 x 208 + 60 x 218 + 6 x 208 = 451,512 bytes.
+// At 30000 / 5000 / 50 Hz the interval is 3600 ticks: the servo and haptic blocks 10 times
+// longer, the physics block the same 6 rows:
+//   4 x 8 x (3600 x 26 + 600 x 30 + 6 x 27) + 3600 x 208 + 600 x 218 + 6 x 208 = 4,457,232.
 // Without the writer thread 1 block is held. Exact: these are integer counts.
 TEST_CASE("the memory estimate is the writer's blocks of one flush interval per table", "[e2e][run_budget]") {
   app::RunOptions options;
   const app::RunFootprint base = app::estimate_footprint(lift({}), options);
-  CHECK(base.memory == 903024.0);
+  CHECK(base.memory == 451512.0);
   CHECK(base.servo_ticks == 12000);
-  CHECK(app::estimate_footprint(lift({"rates.servo=30000", "rates.haptic=5000"}), options).memory == 8914464.0);
+  CHECK(app::estimate_footprint(lift({"rates.servo=30000", "rates.haptic=5000"}), options).memory == 4457232.0);
   options.background_writer = false;
-  CHECK(app::estimate_footprint(lift({}), options).memory == 8.0 * (720 * 26 + 120 * 30 + 12 * 27) + 720 * 208 + 120 * 218 + 12 * 208);
-  CHECK_THAT(base.memory_detail, Contains("/servo: 4 blocks of 720 rows of 26 values"));
+  CHECK(app::estimate_footprint(lift({}), options).memory == 8.0 * (360 * 26 + 60 * 30 + 6 * 27) + 360 * 208 + 60 * 218 + 6 * 208);
+  CHECK_THAT(base.memory_detail, Contains("/servo: 4 blocks of 360 rows of 26 values"));
 }
 
 // The refusal names both figures: memory over what is available refuses; disk over what is free
