@@ -264,6 +264,8 @@ void decimate_trace(const std::string& in, const std::string& out, const Decimat
                                   stride, options.compression),
                            "'" + temporary + "'");
     write_string_attribute(dst.get(), "golden_cpu", cpu_model(), "'" + temporary + "'");
+    if (!options.blessed_changes.empty())
+      write_string_attribute(dst.get(), "blessed_changes", options.blessed_changes, "'" + temporary + "'");
     const Copier copier{in, options.compression};
     for (const std::string& name : link_names(src.get(), where)) {
       const std::string path = "/" + name;

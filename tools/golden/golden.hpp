@@ -35,6 +35,8 @@ inline constexpr std::int64_t kGoldenRowsPerSecond = 500;   // most physics rows
 struct DecimateOptions {
   std::int64_t stride = 0;   // servo ticks
   int compression = 9;
+  std::string blessed_changes;   // root attribute `blessed_changes` when not empty: what the bless
+                                 //    that wrote this golden changed against the one before
 };
 
 // Writes the decimated copy of trace `in` to `out` (replacing it). Throws
