@@ -139,7 +139,7 @@ std::vector<std::string> top_groups(const OpenTrace& t) {
     const H5I_type_t type = object_type(t.file.get(), l, context);
     if (type == H5I_DATASET && is_table_dataset(t.file.get(), l, context)) groups.push_back(l);
     if (type != H5I_GROUP) continue;
-    // A group of tables (/devices/<finger>, issue 6) is compared table by table; any other
+    // A group of tables (/devices/<finger>) is compared table by table; any other
     // group (a schema 2 loop: one dataset per column) as one table.
     std::vector<std::string> children, tables;
     h5::Handle g = h5::checked(H5Gopen2(t.file.get(), l.c_str(), H5P_DEFAULT), H5Gclose,

@@ -47,7 +47,7 @@ std::int64_t servo_rows(const std::string& file) {
 
 // Checks the cut file with h5py in SWMR mode: status; every loop is one table dataset whose
 // columns are members of one row, so they cannot differ in length (with schema 2's dataset per
-// column, a kill between two columns' appends left them apart: seen once as /physics 1488 vs
+// column, a kill between two columns' appends leaves them apart: seen as /physics 1488 vs
 // 1500 rows); /servo tick = 0..n-1 and time = tick / 3000 over its n rows. Prints n.
 constexpr const char* kH5pyCheck = R"PY(
 import sys, h5py, numpy

@@ -93,9 +93,10 @@ std::string status_attribute(const std::string& trace) {
 
 }  // namespace
 
-// Mesh files (scripting/README.md "Mesh files"): a link to /dev/zero read 3 GB in 4 s, a FIFO
-// hung for ever. Now each is refused at once, before a byte is read: exit 2 naming the file and
-// what it is, and no trace written; so are a directory and a file over 64 MiB (sparse: no disk).
+// Mesh files (scripting/README.md "Mesh files"): read unchecked, a link to /dev/zero reads 3 GB in
+// 4 s and a FIFO hangs for ever. Each is refused at once, before a byte is read: exit 2 naming the
+// file and what it is, and no trace written; so are a directory and a file over 64 MiB (sparse:
+// no disk).
 TEST_CASE("catalogue: mesh files that are not regular files, or too large, exit 2 naming the file",
           "[e2e][catalogue][mesh_file]") {
   use_dir("mesh");
@@ -215,15 +216,15 @@ TEST_CASE("catalogue: a damaged string heap and a damaged superblock checksum ex
   }
 }
 
-// 300 one-byte mutants of a real trace made compare crash 7 times and replay 6 times (SIGSEGV).
-// The mutants here: the lift's trace with one byte of its metadata (every byte that is not a
-// table's raw data, found from the chunks' addresses: 28 kB of the 1.2 MB) set to another value,
-// at positions and values drawn by splitmix64 from seed 13, so every run tries the same 300. Each
-// goes through compare, replay and repair. Law: each ends with 0, 1 or 2, never a signal or a
-// hang; and the mutants do damage (at least a fifth of the compares refuse with exit 2; measured
-// 121 of 300), so the test is not passing on harmless bytes. Against the build before these
-// checks, the same 300 made compare and replay die by SIGSEGV 3 times each (libhdf5's string
-// read). About 20 s.
+// One-byte mutants of a trace's metadata crash an unchecked reader (SIGSEGV: 7 compares and 6
+// replays of one set of 300). The mutants here: the lift's trace with one byte of its metadata
+// (every byte that is not a table's raw data, found from the chunks' addresses: 28 kB of the
+// 1.2 MB) set to another value, at positions and values drawn by splitmix64 from seed 13, so every run
+// tries the same 300. Each goes through compare, replay and repair. Law: each ends with 0, 1 or 2,
+// never a signal or a hang; and the mutants do damage (at least a fifth of the compares refuse with
+// exit 2; measured 121 of 300), so the test is not passing on harmless bytes. Without these checks
+// the same 300 make compare and replay die by SIGSEGV 3 times each (libhdf5's string read). About
+// 20 s.
 TEST_CASE("catalogue: 300 seeded one-byte mutants of a trace's metadata: compare, replay and repair end with 0, "
           "1 or 2", "[e2e][catalogue][trace][mutants]") {
   use_dir("mutants");
@@ -293,8 +294,8 @@ TEST_CASE("catalogue: 300 seeded one-byte mutants of a trace's metadata: compare
   CHECK(refused >= kMutants / 5);
 }
 
-// Replayed device input was not checked: NaN HIPs in a replay file ran to exit 0, status
-// complete, with NaN god-objects in the trace. Now a sample that is not finite, or outside the
+// With replayed device input unchecked, NaN HIPs in a replay file would run to exit 0, status
+// complete, with NaN god-objects in the trace. A sample that is not finite, or outside the
 // device's workspace (1 km for a replayed trace), stops the run at its tick: exit 2 naming the
 // finger, the device and the tick; the trace is kept up to the tick before, marked error. Both
 // from `run --device thumb=replay:` and from `graspsim replay`.
@@ -327,8 +328,8 @@ TEST_CASE("catalogue: a replayed HIP that is NaN or outside the workspace stops 
   }
 }
 
-// Sizes without bounds: --duration 1e12 was accepted (1.8 GB in 5 s, then the disk), rates of
-// 1e7 Hz took 5.5 GB for 10,000 ticks, 1e9 Hz ended in a bare std::bad_alloc. The ceilings (24 h,
+// Sizes without bounds: --duration 1e12 would be accepted (1.8 GB in 5 s, then the disk), rates
+// of 1e7 Hz take 5.5 GB for 10,000 ticks, 1e9 Hz ends in a bare std::bad_alloc. The ceilings (24 h,
 // 100 kHz) refuse them as the scenario loads; a run under them that this machine cannot hold is
 // refused before it starts, naming the figure: 20 fingers at 100 kHz for 24 h need about 17 TB
 // of trace. Exit 2, nothing written.
@@ -358,10 +359,10 @@ TEST_CASE("catalogue: runs over the duration or rate ceiling, or too big for the
   }
 }
 
-// A Lua pattern that backtracks (the issue's) hung for ever, at load or mid-run: the count hook
-// never fires inside C. Its steps are now charged to the instruction budget: at load, exit 2 with
-// the budget's message and nothing written; in a trajectory at t = 0.5 s, exit 2 with the trace
-// kept up to there and marked. string.rep("", 1e15) looped in C the same way.
+// A Lua pattern that backtracks (`.-` x 8 over 20000 a's) would hang for ever, at load or mid-run:
+// the count hook never fires inside C. Its steps are charged to the instruction budget: at load,
+// exit 2 with the budget's message and nothing written; in a trajectory at t = 0.5 s, exit 2 with
+// the trace kept up to there and marked. string.rep("", 1e15) would loop in C the same way.
 TEST_CASE("catalogue: a backtracking pattern or an endless string.rep at load or mid-run stops at the budget, exit 2",
           "[e2e][catalogue][lua]") {
   use_dir("lua");

@@ -234,7 +234,7 @@ TEST_CASE("device_server: --help, and clear errors for bad options", "[e2e][udp]
   }
 }
 
-// The whole chain a lab uses (issue 6): `graspsim run --device thumb=udp:...` against a device
+// The whole chain a lab uses: `graspsim run --device thumb=udp:...` against a device
 // server on loopback (here replaying the thumb of a scripted run, in lockstep so the test needs no
 // timing: a lockstep peer waits for graspsim, so the run is not paced and no slow moment of the
 // machine can stop it); the session is recorded in /devices/thumb, and `graspsim replay` of it
@@ -277,7 +277,7 @@ TEST_CASE("graspsim run with a finger on the UDP bridge and its replay are bit f
   CHECK_THAT(replay.output, Catch::Contains("reproduced  bit for bit"));
 }
 
-// The issue's 'done when' for udp: every library scenario with fingers, its first finger switched
+// The bridge, library-wide: every library scenario with fingers, its first finger switched
 // to `udp:...,lockstep` against a device_server replaying that finger of the scenario's own
 // scripted run, gives the scripted run again: the same state hash at every physics tick and the
 // same exit status (the same expectations held). Law: determinism in the inputs: the bridge
@@ -373,8 +373,8 @@ TEST_CASE("graspsim run without lockstep against a lockstep device_server exits 
 // A streamed device and the run start their clocks together. device_server --replay streams a
 // recorded thumb at the run's servo rate on its own clock; that clock starts at the run's first
 // tick (the first force datagram, tick 0's), not at the hello, which comes about half a second
-// earlier while the run sets up: otherwise the first tick already received sample 255 or later,
-// and the replayed thumb led the scripted index for the whole lift (4 of 5 expectations failed).
+// earlier while the run sets up: otherwise the first tick would receive sample 255 or later,
+// and the replayed thumb would lead the scripted index for the whole lift (4 of 5 expectations fail).
 // Law: the lift is its recorded motion only if tick n gets about row n. Tick 0 reads sample 0
 // (the hello's answer); afterwards the stream trails the run by the time the server took to see
 // tick 0's force (scheduling, well under 10 ms = 30 ticks; measured 0.3 to 1.3 ms) and is never

@@ -439,7 +439,7 @@ double pair_energy(const Model& m, const State& s, BodyContacts& contacts) {
 //  - after the first contact the energy never rises by more than 2e-2 of the drop energy m g h
 //    (symplectic Euler at 3000 Hz: the shadow-energy wobble of a stiff penalty impact, O(w h) of
 //    its energy, w = sqrt(n k / m) up to 70 rad/s, w h = 0.024; measured <= 6e-4; a sign error
-//    pumps energy in by far more: a mesh with the higher index flew off at metres per second).
+//    pumps energy in by far more: a mesh with the higher index flies off at metres per second).
 // Loose bounds where FCL gives the points (see `exact`): above the lower body, slower than
 // 2 cm/s, overlap between m g / (16 k) and m g / k, energy rise under 1.2 m g h (measured up to
 // 1.0 for a cylinder on a mesh: bounded, but not the penalty law's).
@@ -515,7 +515,7 @@ TEST_CASE("every pair of shape kinds rests in either body order at m g / (n k)",
 }
 
 // Two undamped materials in series: a zero damper in series with a zero damper is no damper
-// (c_a c_b / (c_a + c_b) = 0 / 0 was NaN, and the bodies passed through each other); the pair
+// (c_a c_b / (c_a + c_b) = 0 / 0 would be NaN, and the bodies pass through each other); the pair
 // still collides. A mesh against a mesh does not, and the warning says so.
 TEST_CASE("two undamped materials give an undamped pair, and mesh against mesh is flagged", "[object_contact][law]") {
   const ContactPair p = contact_pair(Material{0.5, 1000.0, 0.0}, Material{0.5, 1000.0, 0.0});

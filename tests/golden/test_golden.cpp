@@ -1,7 +1,6 @@
-// Golden regressions (issue 4, item 5) and determinism (item 6): every scenario reruns and
-// matches its golden trace bit for bit; the same scenario gives the same trace in one process,
-// in two processes and from a Debug and a Release build. README.md, "Golden traces" and
-// "Determinism".
+// Golden regressions and determinism: every scenario reruns and matches its golden trace bit for
+// bit; the same scenario gives the same trace in one process, in two processes and from a Debug and
+// a Release build. README.md, "Golden traces" and "Determinism".
 #include <catch2/catch.hpp>
 #include <hdf5.h>
 #include <sys/wait.h>
@@ -66,7 +65,7 @@ void set_root_string(const std::string& file, const std::string& name, const std
 
 }  // namespace
 
-// Item 5. Each scenario reruns in process at its own rates (as `tools/bless` ran it) and its
+// Goldens. Each scenario reruns in process at its own rates (as `tools/bless` ran it) and its
 // full trace is compared bitwise with the golden through recordings::compare_traces: every
 // golden row (all /physics rows with the state hash, /servo and /haptic at physics ticks) must
 // find its tick and be bit-identical. A failure names the first diverging tick and quantity and
@@ -218,7 +217,7 @@ TEST_CASE("tools/bless leaves a matching golden alone and refuses bad input", "[
   CHECK(shell(bless).status == 2);
 }
 
-// Item 6, in one process: two runs give the same trace bit for bit and the same attributes
+// Determinism in one process: two runs give the same trace bit for bit and the same attributes
 // (none is wall-clock), also when the rows are written in other blocks (other flush points:
 // the flushes change where data lands in the file, never the data).
 TEST_CASE("repeated runs in one process give bit-identical traces and attributes", "[determinism]") {
@@ -245,7 +244,7 @@ TEST_CASE("repeated runs in one process give bit-identical traces and attributes
   }
 }
 
-// Item 6, across processes: two `graspsim run` child processes, compared by `graspsim compare
+// Determinism across processes: two `graspsim run` child processes, compared by `graspsim compare
 // --bitwise` (and a third with --compress 4: compression changes the bytes, not the values).
 TEST_CASE("two graspsim run processes give bit-identical traces", "[determinism]") {
   const std::string cli = GRASPSIM_CLI;
@@ -264,7 +263,7 @@ TEST_CASE("two graspsim run processes give bit-identical traces", "[determinism]
 }
 
 #ifdef GRASPSIM_CLI_TWIN
-// Item 6, Debug against Release: the same source built at -O0 (Debug, Eigen's assertions on)
+// Determinism, Debug against Release: the same source built at -O0 (Debug, Eigen's assertions on)
 // and -O2 (Release), both with -ffp-contract=off, give bit-identical traces on this machine.
 // The twin binary is built by tests/golden/CMakeLists.txt (ExternalProject) into build/debug.
 TEST_CASE("a Debug and a Release build give bit-identical traces", "[determinism]") {

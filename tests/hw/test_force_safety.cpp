@@ -276,7 +276,7 @@ TEST_CASE("device_model: the table holds the four models and an unknown name lis
   CHECK(device_models().size() == 4);
   const DeviceModel& premium = device_model("premium-1.5");
   CHECK(&device_model("Phantom Premium 1.5") == &premium);
-  // The issue's figures for the Premium 1.5.
+  // The Premium 1.5's figures (hw/README.md, "Device models").
   CHECK(premium.peak_force == 8.5);
   CHECK(premium.continuous_force == 1.4);
   CHECK(premium.tip_mass == 0.075);

@@ -191,8 +191,8 @@ TEST_CASE("bad sleep values are named with their field", "[scenario][errors]") {
 
 // The ceilings on a run's size (scenario.hpp, scripting/README.md "Ceilings"): rates.servo up to
 // 100 kHz and duration up to 86,400 s load, one step over is refused naming the field and the
-// ceiling (the figures the issue tried: --duration 1e12, rates of 1e7 and 1e9 Hz). Loads only:
-// nothing runs.
+// ceiling (figures that would exhaust a machine: --duration 1e12, rates of 1e7 and 1e9 Hz). Loads
+// only: nothing runs.
 TEST_CASE("rates.servo and duration have ceilings: at the ceiling a scenario loads, one step over it is "
           "refused naming the figure", "[scenario][errors][ceiling]") {
   CHECK(message({"rates.servo=100000", "rates.haptic=100000", "rates.physics=100000"}) == "no error");

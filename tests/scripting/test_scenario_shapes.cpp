@@ -99,7 +99,7 @@ std::string ascii_stl(const std::vector<std::array<Vec3, 3>>& triangles) {
 
 TEST_CASE("every shape loads with its mass properties from density or mass", "[scripting][shape]") {
   const Scenario s = Scenario::load(data_path("shapes.lua"));
-  // box: m = rho x y z, box_inertia (unchanged from before shapes).
+  // box: m = rho x y z, box_inertia.
   CHECK(body(s, "box").shape.kind == ShapeKind::kBox);
   CHECK(body(s, "box").mass == 500.0 * 0.02 * 0.04 * 0.06);
   // sphere: m = rho 4/3 pi r^3, J = 2/5 m r^2.

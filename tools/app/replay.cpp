@@ -178,15 +178,15 @@ ReplayPlan load(const std::string& trace, const ReplayOptions& options) {
                       std::to_string(recordings::kSchemaVersion) + ")");
   }
   plan.status = required_string(trace, "status");
-  // The run's force ramp (0 in traces from before it was recorded): rendered forces again.
+  // The run's force ramp (absent: 0, no ramp): rendered forces again.
   if (recordings::has_attribute(trace, "/", "force_ramp"))
     plan.force_ramp = recordings::read_double_attribute(trace, "/", "force_ramp");
   plan.scenario_path = required_string(trace, "scenario_path");
   plan.scenario_source_hash = required_string(trace, "scenario_source_hash");
   const std::string source = required_string(trace, "scenario_source");
   plan.overrides = split_lines(required_string(trace, "overrides"));
-  // A trace without `integrator` comes from before the implicit step, when every run used the
-  // paper's: it replays with it (first, so that a --set integrator= still wins).
+  // A trace without `integrator` used the paper's step (every run that could use another
+  // records it): it replays with it (first, so that a --set integrator= still wins).
   if (!recordings::has_attribute(trace, "/", "integrator")) plan.overrides.insert(plan.overrides.begin(), "integrator=paper");
   plan.overrides.insert(plan.overrides.end(), options.sets.begin(), options.sets.end());
   plan.what_if = !options.sets.empty();
@@ -341,7 +341,7 @@ RunOptions ReplayPlan::run_options(const std::string& out) const {
   options.attributes.emplace_back("replay_of", replay_of());
   for (const RecordedFinger& r : fingers) {
     options.record_devices.push_back(r.device.has_value());
-    // A trace from before the counter columns: the replay writes none either, so that it can
+    // A device table without the counter columns: the replay writes none either, so that it can
     // equal the recording (compare refuses tables whose columns differ).
     if (r.device && !r.device->counted) options.device_counters = false;
   }

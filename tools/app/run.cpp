@@ -478,7 +478,7 @@ RunResult run_scenario(const scripting::Scenario& scenario, const RunOptions& op
       }
       if (recorder) {
         recorder->record(record, rendered, input, sim.state());
-        // A countdown, not (n + 1) % flush_ticks: a 64-bit division every tick was an eighth
+        // A countdown, not (n + 1) % flush_ticks: a 64-bit division every tick would be an eighth
         // of what logging cost the run loop (perf, the 40 s lift).
         if (--until_flush == 0 ||
             (n % kWallCheckTicks == 0 && seconds_since(last_flush) >= kFlushWall)) {

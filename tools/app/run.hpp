@@ -49,7 +49,7 @@ struct RunOptions {
   // (empty: none; the fingers of non-scripted devices, DevicePlan::recorded()).
   std::vector<bool> record_devices;
   // Whether /devices tables get the `sequence` and `new_samples` columns (false: a replay of a
-  // trace written before they existed, so that the replay can equal it).
+  // trace whose tables lack them, so that the replay can equal it).
   bool device_counters = true;
   // Fingers whose device does not run the finger's script itself (udp, phantom; empty: none,
   // DevicePlan::script_alongside()): the run evaluates that script at every tick before the
