@@ -250,7 +250,11 @@ RunResult run_scenario(const scripting::Scenario& scenario, const RunOptions& op
   writer.set_attribute("seed", static_cast<std::int64_t>(scenario.seed()));
   writer.set_attribute("duration", scenario.duration());
   writer.set_attribute("graspsim_version", GRASPSIM_VERSION);
-  writer.set_attribute("compiler", std::string("g++ ") + __VERSION__);
+#if defined(__clang__)
+  writer.set_attribute("compiler", std::string("clang++ ") + __VERSION__);   // "clang++ Debian Clang 14.0.6"
+#else
+  writer.set_attribute("compiler", std::string("g++ ") + __VERSION__);       // "g++ 12.2.0"
+#endif
   writer.set_attribute("build_flags", GRASPSIM_BUILD_FLAGS);
   for (const auto& [name, value] : options.attributes) writer.set_attribute(name, value);
 
