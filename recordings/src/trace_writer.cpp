@@ -61,26 +61,6 @@ hid_t memory_type_of(DType dtype) {
   return H5T_NATIVE_DOUBLE;
 }
 
-std::size_t size_of(DType dtype) {
-  switch (dtype) {
-    case DType::kFloat64: case DType::kInt64: case DType::kUInt64: return 8;
-    case DType::kInt32: return 4;
-    case DType::kInt8: return 1;
-  }
-  return 8;
-}
-
-const char* name_of(DType dtype) {
-  switch (dtype) {
-    case DType::kFloat64: return "float64";
-    case DType::kInt64: return "int64";
-    case DType::kInt32: return "int32";
-    case DType::kInt8: return "int8";
-    case DType::kUInt64: return "uint64";
-  }
-  return "?";
-}
-
 // Inclusive range of an integer dtype as doubles (both ends exact in double). int64's upper
 // end 2^63 - 1 is not a double, so that check is "below 2^63" (see fits()).
 double lowest(DType dtype) {
