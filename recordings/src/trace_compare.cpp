@@ -530,93 +530,113 @@ int loop_rank(const std::string& g) {
   return 3;
 }
 
-void compare_loop(const OpenTrace& a, const OpenTrace& b, const std::string& group,
-                  const CompareOptions& options, std::vector<bool>& rule_used,
-                  CompareResult& result) {
-  const std::vector<std::string> names_a = datasets_below(a, group);
+// The columns of one loop in both traces, opened and paired by name.
+struct LoopColumns {
+  std::vector<std::string> names;          // sorted; the same in both traces
+  std::vector<Column> a, b;                // names[k] in each trace
+  std::int64_t rows_a = 0, rows_b = 0;     // rows every column of the table holds
+  std::size_t tick = 0, time = 0;          // indices of the tick and time columns
+};
+
+// A table's datasets grow together; if they do not (a write cut by a crash), only the rows
+// every dataset holds are compared, with a note.
+std::int64_t usable_rows(const std::vector<Column>& cols, const OpenTrace& t, const std::string& group,
+                         CompareResult& result) {
+  std::int64_t lo = cols.front().rows, hi = cols.front().rows;
+  for (const Column& c : cols) lo = std::min(lo, c.rows), hi = std::max(hi, c.rows);
+  if (lo != hi)
+    result.notes.push_back(quoted(t.name) + ": the datasets of /" + group + " hold " +
+                           std::to_string(lo) + " to " + std::to_string(hi) +
+                           " rows (a write cut short?); the first " + std::to_string(lo) +
+                           " are compared");
+  return lo;
+}
+
+// Opens the columns of loop `group` in both traces: the same names in each, a tick and a time
+// column, and a tick column of one integer per row.
+LoopColumns open_loop(const OpenTrace& a, const OpenTrace& b, const std::string& group,
+                      CompareResult& result) {
+  LoopColumns cols;
+  cols.names = datasets_below(a, group);
   const std::vector<std::string> names_b = datasets_below(b, group);
-  for (const std::string& n : names_a)
+  for (const std::string& n : cols.names)
     if (!std::binary_search(names_b.begin(), names_b.end(), n))
       fail("dataset " + quoted("/" + group + "/" + n) + " is in " + quoted(a.name) +
            " but missing in " + quoted(b.name));
   for (const std::string& n : names_b)
-    if (!std::binary_search(names_a.begin(), names_a.end(), n))
+    if (!std::binary_search(cols.names.begin(), cols.names.end(), n))
       fail("dataset " + quoted("/" + group + "/" + n) + " is in " + quoted(b.name) +
            " but missing in " + quoted(a.name));
   for (const char* key : {"tick", "time"})
-    if (!std::binary_search(names_a.begin(), names_a.end(), key))
+    if (!std::binary_search(cols.names.begin(), cols.names.end(), key))
       fail("table " + quoted("/" + group) + " of " + quoted(a.name) + " and " + quoted(b.name) +
            " has no " + quoted(key) + " column, so its rows cannot be aligned");
-
-  std::vector<Column> cols_a, cols_b;
-  for (const std::string& n : names_a) {
-    cols_a.push_back(open_column(a, group, n));
-    cols_b.push_back(open_column(b, group, n));
+  for (const std::string& n : cols.names) {
+    cols.a.push_back(open_column(a, group, n));
+    cols.b.push_back(open_column(b, group, n));
   }
-  // A table's datasets grow together; if they do not (a write cut by a crash), only the rows
-  // every dataset holds are compared.
-  const auto usable_rows = [&](const std::vector<Column>& cols, const OpenTrace& t) {
-    std::int64_t lo = cols.front().rows, hi = cols.front().rows;
-    for (const Column& c : cols) lo = std::min(lo, c.rows), hi = std::max(hi, c.rows);
-    if (lo != hi)
-      result.notes.push_back(quoted(t.name) + ": the datasets of /" + group + " hold " +
-                             std::to_string(lo) + " to " + std::to_string(hi) +
-                             " rows (a write cut short?); the first " + std::to_string(lo) +
-                             " are compared");
-    return lo;
-  };
-  const std::int64_t rows_a = usable_rows(cols_a, a), rows_b = usable_rows(cols_b, b);
-
+  cols.rows_a = usable_rows(cols.a, a, group, result);
+  cols.rows_b = usable_rows(cols.b, b, group, result);
   const auto index_of = [&](const char* key) {
     return static_cast<std::size_t>(
-        std::lower_bound(names_a.begin(), names_a.end(), key) - names_a.begin());
+        std::lower_bound(cols.names.begin(), cols.names.end(), key) - cols.names.begin());
   };
-  const std::size_t tick_i = index_of("tick"), time_i = index_of("time");
-  for (const Column* c : {&cols_a[tick_i], &cols_b[tick_i]})
+  cols.tick = index_of("tick");
+  cols.time = index_of("time");
+  for (const Column* c : {&cols.a[cols.tick], &cols.b[cols.tick]})
     if (c->kind == Kind::kFloat || c->width != 1)
       fail("trace " + quoted(c->file) + ", dataset " + quoted(c->path) +
            ": a tick column holds one integer per row");
-  // A compound table is read a block of whole rows at a time, shared by its columns, and
-  // compared block by block (every column of a block, then the next block), so each row of
-  // the file is read once. A block is at most 4 MiB of rows.
-  std::optional<TableRows> table_a, table_b;
-  std::int64_t step = static_cast<std::int64_t>(std::max<std::size_t>(options.block_rows, 1));
-  if (!cols_a[tick_i].member.empty() && !cols_b[tick_i].member.empty()) {
-    const auto share = [&](std::optional<TableRows>& t, std::vector<Column>& cols, const OpenTrace& o,
-                           std::int64_t rows) {
-      t.emplace();
-      t->file = o.name;
-      t->path = "/" + group;
-      t->dataset = cols[tick_i].dataset.get();
-      const std::string context = "trace " + quoted(o.name) + ", table " + quoted("/" + group);
-      h5::Handle file_type = h5::checked(H5Dget_type(t->dataset), H5Tclose, context);
-      t->type = h5::checked(H5Tget_native_type(file_type.get(), H5T_DIR_ASCEND), H5Tclose, context);
-      t->row_bytes = H5Tget_size(t->type.get());
-      t->rows = rows;
-      t->block = std::max<std::int64_t>(1, std::min<std::int64_t>(
-                                               step, static_cast<std::int64_t>((4u << 20) / std::max<std::size_t>(t->row_bytes, 1))));
-      for (Column& c : cols) c.table_rows = &*t;
-    };
-    share(table_a, cols_a, a, rows_a);
-    share(table_b, cols_b, b, rows_b);
-    step = std::min(table_a->block, table_b->block);
-  }
+  return cols;
+}
 
-  const std::vector<std::int64_t> ticks_a = read_all<std::int64_t>(cols_a[tick_i], rows_a, options.block_rows);
-  const std::vector<std::int64_t> ticks_b = read_all<std::int64_t>(cols_b[tick_i], rows_b, options.block_rows);
-  for (const auto* t : {&ticks_a, &ticks_b})
-    for (std::size_t r = 1; r < t->size(); ++r)
-      if ((*t)[r] <= (*t)[r - 1])
-        fail("trace " + quoted(t == &ticks_a ? a.name : b.name) + ", dataset " +
-             quoted("/" + group + "/tick") + ": ticks do not increase at row " +
-             std::to_string(r) + " (" + std::to_string((*t)[r - 1]) + " then " +
-             std::to_string((*t)[r]) + ")");
-  const std::vector<double> times_a = read_all<double>(cols_a[time_i], rows_a, options.block_rows);
+// The rows a compound table's columns share, in each trace, and the rows compared at a time.
+struct SharedRows {
+  std::optional<TableRows> a, b;   // empty for a schema 2 group of datasets
+  std::int64_t step = 1;           // rows per block of every column reader
+};
 
-  LoopAlignment loop;
-  loop.loop = group;
-  loop.rows_a = rows_a;
-  loop.rows_b = rows_b;
+// A compound table is read a block of whole rows at a time, shared by its columns, and
+// compared block by block (every column of a block, then the next block), so each row of the
+// file is read once. A block is at most 4 MiB of rows and at most `block_rows`. The columns
+// point at `shared`, which must stay where it is while they are read.
+void share_table_rows(SharedRows& shared, LoopColumns& cols, const OpenTrace& a, const OpenTrace& b,
+                      const std::string& group, std::size_t block_rows) {
+  shared.step = static_cast<std::int64_t>(std::max<std::size_t>(block_rows, 1));
+  if (cols.a[cols.tick].member.empty() || cols.b[cols.tick].member.empty()) return;
+  const auto share = [&](std::optional<TableRows>& t, std::vector<Column>& columns,
+                         const OpenTrace& o, std::int64_t rows) {
+    t.emplace();
+    t->file = o.name;
+    t->path = "/" + group;
+    t->dataset = columns[cols.tick].dataset.get();
+    const std::string context = "trace " + quoted(o.name) + ", table " + quoted("/" + group);
+    h5::Handle file_type = h5::checked(H5Dget_type(t->dataset), H5Tclose, context);
+    t->type = h5::checked(H5Tget_native_type(file_type.get(), H5T_DIR_ASCEND), H5Tclose, context);
+    t->row_bytes = H5Tget_size(t->type.get());
+    t->rows = rows;
+    t->block = std::max<std::int64_t>(
+        1, std::min<std::int64_t>(shared.step, static_cast<std::int64_t>((4u << 20) / std::max<std::size_t>(t->row_bytes, 1))));
+    for (Column& c : columns) c.table_rows = &*t;
+  };
+  share(shared.a, cols.a, a, cols.rows_a);
+  share(shared.b, cols.b, b, cols.rows_b);
+  shared.step = std::min(shared.a->block, shared.b->block);
+}
+
+// Throws unless the ticks of `c` (read whole) strictly increase.
+void check_increasing(const std::vector<std::int64_t>& ticks, const Column& c) {
+  for (std::size_t r = 1; r < ticks.size(); ++r)
+    if (ticks[r] <= ticks[r - 1])
+      fail("trace " + quoted(c.file) + ", dataset " + quoted(c.path) + ": ticks do not increase at row " +
+           std::to_string(r) + " (" + std::to_string(ticks[r - 1]) + " then " +
+           std::to_string(ticks[r]) + ")");
+}
+
+// Pairs the rows of A and B with the same tick (a merge join of two increasing tick columns),
+// counting the ticks found in one trace only in `loop`.
+Alignment align(const std::vector<std::int64_t>& ticks_a, const std::vector<std::int64_t>& ticks_b,
+                const std::vector<double>& times_a, LoopAlignment& loop) {
   Alignment al;
   std::size_t i = 0, j = 0;
   while (i < ticks_a.size() || j < ticks_b.size()) {
@@ -635,18 +655,44 @@ void compare_loop(const OpenTrace& a, const OpenTrace& b, const std::string& gro
     }
   }
   loop.matched = static_cast<std::int64_t>(al.tick.size());
-  result.loops.push_back(loop);
+  return al;
+}
 
+// One column compared: its result so far, and the readers of its rows in A and B.
+struct ColumnPair {
   using Readers = std::variant<std::pair<BlockReader<double>, BlockReader<double>>,
                                std::pair<BlockReader<std::int64_t>, BlockReader<std::int64_t>>,
                                std::pair<BlockReader<std::uint64_t>, BlockReader<std::uint64_t>>>;
-  std::vector<DatasetResult> found;
-  std::vector<Readers> readers;
-  std::vector<std::size_t> widths;
-  for (std::size_t k = 0; k < names_a.size(); ++k) {
-    if (k == tick_i) continue;   // the key the rows were aligned by
-    const Column& ca = cols_a[k];
-    const Column& cb = cols_b[k];
+  DatasetResult result;
+  Readers readers;
+  std::size_t width = 1;
+};
+
+// The tolerance of dataset `d`: the last rule whose pattern matches it, else the global one;
+// none in bitwise mode. Marks the rule used.
+void set_tolerance(DatasetResult& d, const CompareOptions& options, std::vector<bool>& rule_used) {
+  d.tolerance = options.tolerance;
+  for (std::size_t r = 0; r < options.rules.size(); ++r) {
+    if (tolerance_pattern_matches(options.rules[r].pattern, d.path)) {
+      d.tolerance = options.rules[r].tolerance;
+      d.rule = options.rules[r].pattern;
+      rule_used[r] = true;
+    }
+  }
+  if (options.bitwise) d.tolerance = Tolerance{};
+}
+
+// Every column but the tick (the key the rows were aligned by), checked to have the same shape
+// and kind in both traces, described, given its tolerance and its readers.
+std::vector<ColumnPair> pair_columns(const LoopColumns& cols, const OpenTrace& a, const OpenTrace& b,
+                                     const std::string& group, const CompareOptions& options,
+                                     std::int64_t step, std::vector<bool>& rule_used) {
+  std::vector<ColumnPair> pairs;
+  const std::size_t block = static_cast<std::size_t>(step);
+  for (std::size_t k = 0; k < cols.names.size(); ++k) {
+    if (k == cols.tick) continue;
+    const Column& ca = cols.a[k];
+    const Column& cb = cols.b[k];
     if (ca.rank != cb.rank || ca.width != cb.width)
       fail("dataset " + quoted(ca.path) + " has different shapes: " + shape_text(ca) + " in " +
            quoted(a.name) + ", " + shape_text(cb) + " in " + quoted(b.name));
@@ -654,50 +700,71 @@ void compare_loop(const OpenTrace& a, const OpenTrace& b, const std::string& gro
       fail(std::string("dataset ") + quoted(ca.path) + " holds " + kind_text(ca.kind) + "s in " +
            quoted(a.name) + " but " + kind_text(cb.kind) + "s in " + quoted(b.name));
     DatasetResult d;
-    d.path = group + "/" + names_a[k];
+    d.path = group + "/" + cols.names[k];
     describe(d, ca);
     d.integer = ca.kind != Kind::kFloat;
-    d.tolerance = options.tolerance;
-    for (std::size_t r = 0; r < options.rules.size(); ++r) {
-      if (tolerance_pattern_matches(options.rules[r].pattern, d.path)) {
-        d.tolerance = options.rules[r].tolerance;
-        d.rule = options.rules[r].pattern;
-        rule_used[r] = true;
+    set_tolerance(d, options, rule_used);
+    const auto readers = [&]() -> ColumnPair::Readers {
+      switch (ca.kind) {
+        case Kind::kFloat:
+          return ColumnPair::Readers(std::in_place_index<0>, BlockReader<double>(ca, cols.rows_a, block),
+                                     BlockReader<double>(cb, cols.rows_b, block));
+        case Kind::kSigned:
+          return ColumnPair::Readers(std::in_place_index<1>, BlockReader<std::int64_t>(ca, cols.rows_a, block),
+                                     BlockReader<std::int64_t>(cb, cols.rows_b, block));
+        default:
+          return ColumnPair::Readers(std::in_place_index<2>, BlockReader<std::uint64_t>(ca, cols.rows_a, block),
+                                     BlockReader<std::uint64_t>(cb, cols.rows_b, block));
       }
-    }
-    if (options.bitwise) d.tolerance = Tolerance{};
-    const std::size_t block = static_cast<std::size_t>(step);
-    switch (ca.kind) {
-      case Kind::kFloat:
-        readers.emplace_back(std::in_place_index<0>, BlockReader<double>(ca, rows_a, block),
-                             BlockReader<double>(cb, rows_b, block));
-        break;
-      case Kind::kSigned:
-        readers.emplace_back(std::in_place_index<1>, BlockReader<std::int64_t>(ca, rows_a, block),
-                             BlockReader<std::int64_t>(cb, rows_b, block));
-        break;
-      case Kind::kUnsigned:
-        readers.emplace_back(std::in_place_index<2>, BlockReader<std::uint64_t>(ca, rows_a, block),
-                             BlockReader<std::uint64_t>(cb, rows_b, block));
-        break;
-    }
-    widths.push_back(ca.width);
-    found.push_back(std::move(d));
+    };
+    pairs.push_back(ColumnPair{std::move(d), readers(), ca.width});
   }
-  // A range of aligned rows whose rows lie in one block of each file (a decimated or cut trace
-  // skips rows: its range ends where its rows would leave the block).
-  const std::int64_t block_a = table_a ? table_a->block : step, block_b = table_b ? table_b->block : step;
+  return pairs;
+}
+
+// Compares every column over the aligned rows, a range at a time whose rows lie in one block of
+// each file (a decimated or cut trace skips rows: its range ends where its rows would leave the
+// block), so each block is read once for all columns.
+void compare_aligned(std::vector<ColumnPair>& pairs, const Alignment& al, const SharedRows& shared,
+                     const CompareOptions& options) {
+  const std::int64_t block_a = shared.a ? shared.a->block : shared.step;
+  const std::int64_t block_b = shared.b ? shared.b->block : shared.step;
   for (std::size_t k0 = 0, k1 = 0; k0 < al.tick.size(); k0 = k1) {
     k1 = k0 + 1;
     while (k1 < al.tick.size() && al.row_a[k1] - al.row_a[k0] < block_a &&
            al.row_b[k1] - al.row_b[k0] < block_b)
       ++k1;
-    for (std::size_t c = 0; c < found.size(); ++c) {
-      std::visit([&](auto& pair) { compare_range(pair.first, pair.second, widths[c], k0, k1, al, options, found[c]); },
-                 readers[c]);
+    for (ColumnPair& p : pairs) {
+      std::visit([&](auto& r) { compare_range(r.first, r.second, p.width, k0, k1, al, options, p.result); },
+                 p.readers);
     }
   }
-  for (DatasetResult& d : found) result.datasets.push_back(std::move(d));
+}
+
+// One loop (a table with a tick column): open its columns, align its rows by tick, compare
+// every other column on the aligned rows.
+void compare_loop(const OpenTrace& a, const OpenTrace& b, const std::string& group,
+                  const CompareOptions& options, std::vector<bool>& rule_used,
+                  CompareResult& result) {
+  LoopColumns cols = open_loop(a, b, group, result);
+  SharedRows shared;
+  share_table_rows(shared, cols, a, b, group, options.block_rows);
+
+  const auto ticks_a = read_all<std::int64_t>(cols.a[cols.tick], cols.rows_a, options.block_rows);
+  const auto ticks_b = read_all<std::int64_t>(cols.b[cols.tick], cols.rows_b, options.block_rows);
+  check_increasing(ticks_a, cols.a[cols.tick]);
+  check_increasing(ticks_b, cols.b[cols.tick]);
+  const auto times_a = read_all<double>(cols.a[cols.time], cols.rows_a, options.block_rows);
+  LoopAlignment loop;
+  loop.loop = group;
+  loop.rows_a = cols.rows_a;
+  loop.rows_b = cols.rows_b;
+  const Alignment al = align(ticks_a, ticks_b, times_a, loop);
+  result.loops.push_back(loop);
+
+  std::vector<ColumnPair> pairs = pair_columns(cols, a, b, group, options, shared.step, rule_used);
+  compare_aligned(pairs, al, shared, options);
+  for (ColumnPair& p : pairs) result.datasets.push_back(std::move(p.result));
 }
 
 CompareResult compare_impl(const std::string& file_a, const std::string& file_b,
