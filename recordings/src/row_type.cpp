@@ -1,34 +1,7 @@
-// Row types of a trace table: dtype to HDF5 type, the compound row, integer range checks.
+// Row types of a trace table: dtype to HDF5 type, the compound row, its encoded size.
 #include "row_type.hpp"
 
-#include <cmath>
-
 namespace graspsim::recordings::writer {
-namespace {
-
-// Inclusive range of an integer dtype as doubles (both ends exact in double). int64's upper
-// end 2^63 - 1 is not a double, so that check is "below 2^63" (see fits()).
-double lowest(DType dtype) {
-  switch (dtype) {
-    case DType::kInt64: return -9223372036854775808.0;   // -2^63
-    case DType::kInt32: return -2147483648.0;
-    case DType::kInt8: return -128.0;
-    case DType::kFloat64: case DType::kUInt64: break;
-  }
-  return 0.0;
-}
-
-double highest(DType dtype) {
-  switch (dtype) {
-    case DType::kInt64: return 9223372036854775808.0;    // 2^63, exclusive
-    case DType::kInt32: return 2147483647.0;
-    case DType::kInt8: return 127.0;
-    case DType::kFloat64: case DType::kUInt64: break;
-  }
-  return 0.0;
-}
-
-}  // namespace
 
 hid_t file_type_of(DType dtype) {
   switch (dtype) {
@@ -50,12 +23,6 @@ hid_t memory_type_of(DType dtype) {
     case DType::kUInt64: return H5T_NATIVE_UINT64;
   }
   return H5T_NATIVE_DOUBLE;
-}
-
-bool fits(double value, DType dtype) {
-  if (!(value == std::trunc(value))) return false;   // also rejects NaN and infinities
-  if (value < lowest(dtype)) return false;
-  return dtype == DType::kInt64 ? value < highest(dtype) : value <= highest(dtype);
 }
 
 h5::Handle row_type(const std::vector<Column>& columns, std::size_t bytes, bool memory,

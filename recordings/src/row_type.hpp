@@ -2,6 +2,7 @@
 // row type built from the columns, and the check that a value fits an integer column.
 #pragma once
 
+#include <cmath>
 #include <cstddef>
 #include <string>
 #include <vector>
@@ -22,9 +23,36 @@ struct Column {
 hid_t file_type_of(DType dtype);     // little-endian, as stored
 hid_t memory_type_of(DType dtype);   // native
 
+// Inclusive range of an integer dtype as doubles (both ends exact in double). int64's upper
+// end 2^63 - 1 is not a double, so that check is "below 2^63" (see fits()).
+constexpr double lowest(DType dtype) {
+  switch (dtype) {
+    case DType::kInt64: return -9223372036854775808.0;   // -2^63
+    case DType::kInt32: return -2147483648.0;
+    case DType::kInt8: return -128.0;
+    case DType::kFloat64: case DType::kUInt64: break;
+  }
+  return 0.0;
+}
+
+constexpr double highest(DType dtype) {
+  switch (dtype) {
+    case DType::kInt64: return 9223372036854775808.0;    // 2^63, exclusive
+    case DType::kInt32: return 2147483647.0;
+    case DType::kInt8: return 127.0;
+    case DType::kFloat64: case DType::kUInt64: break;
+  }
+  return 0.0;
+}
+
 // Whether a row value (a double) is an integer in the range of integer dtype `dtype`: false for
-// a fraction, NaN or an infinity, or a value out of range.
-bool fits(double value, DType dtype);
+// a fraction, NaN or an infinity, or a value out of range. Inline: called for every integer
+// value of every row written.
+inline bool fits(double value, DType dtype) {
+  if (!(value == std::trunc(value))) return false;   // also rejects NaN and infinities
+  if (value < lowest(dtype)) return false;
+  return dtype == DType::kInt64 ? value < highest(dtype) : value <= highest(dtype);
+}
 
 // The compound type of a row: one member per column in declaration order, packed into `bytes`;
 // array members for width > 1. `memory`: native types, else the file's.
