@@ -1,7 +1,7 @@
-// The trace schema as data: one table of fields per record. TraceRecorder declares its columns
-// and fills its rows from these tables, and tests/e2e/test_trace_schema.cpp checks
-// recordings/README.md against them, so a new column is one line here (plus its member in the
-// record and its row in the README).
+// The trace schema as data: one table of fields per record. TraceRecorder and DeviceRecorder
+// declare their columns and fill their rows from these tables, and
+// tests/e2e/test_trace_schema.cpp checks recordings/README.md against them, so a new column is
+// one line here (plus its member in the record and its row in the README).
 #pragma once
 
 #include <cstddef>
@@ -59,6 +59,12 @@ struct Stored<std::int64_t> {
   static constexpr DType dtype = DType::kInt64;
   static constexpr int width = 1;
   static void put(std::int64_t v, double* out) { out[0] = static_cast<double>(v); }
+};
+template <>
+struct Stored<std::int8_t> {
+  static constexpr DType dtype = DType::kInt8;
+  static constexpr int width = 1;
+  static void put(std::int8_t v, double* out) { out[0] = static_cast<double>(v); }
 };
 template <>
 struct Stored<std::uint64_t> {
@@ -126,6 +132,25 @@ struct ServoFingerRow {
   Vec3 gimbal;         // rad: FingerInput::gimbal (roll, pitch, yaw)
 };
 
+// /devices/<finger> per servo tick, for a finger driven by a device that is not scripted: the
+// device's own view of the sample it gave and of the force it was sent (DeviceRecorder).
+struct DeviceRow {
+  std::int64_t tick = 0;       // servo tick the sample was used at
+  double time = 0.0;           // s: tick / rate_servo
+  double device_time = 0.0;    // s: when the device took the sample, on its own clock
+  Vec3 position{0.0, 0.0, 0.0};   // m, device frame: before the workspace mapping
+  Vec3 gimbal{0.0, 0.0, 0.0};     // rad: stylus gimbal angles (roll, pitch, yaw)
+  std::int64_t buttons = 0;       // 1: bit i set while button i was pressed
+  Vec3 force{0.0, 0.0, 0.0};      // N, device frame: the force requested of the device
+  std::int8_t overrun = 0;        // 1 when this servo tick missed its real-time deadline
+};
+// /devices/<finger> after DeviceRow, when the run records the device's sample numbering.
+struct DeviceCounterRow {
+  std::int64_t sequence = -1;      // 1: the device's own number of the sample; -1 without one
+  std::int64_t new_samples = -1;   // 1: new samples since the previous servo tick; -1 without
+};
+
+inline constexpr std::string_view kDevices = "devices/";   // + <finger>
 inline constexpr std::string_view kServo = "servo";        // every servo tick
 inline constexpr std::string_view kHaptic = "haptic";      // every haptic tick
 inline constexpr std::string_view kPhysics = "physics";    // every physics tick
@@ -175,6 +200,22 @@ inline constexpr Field<BodyRecord> kBodyFields[] = {
     field<&BodyRecord::twist>("twist", "rad"),
 };
 
+inline constexpr Field<DeviceRow> kDeviceFields[] = {
+    field<&DeviceRow::tick>("tick", "tick"),
+    field<&DeviceRow::time>("time", "s"),
+    field<&DeviceRow::device_time>("device_time", "s"),
+    field<&DeviceRow::position>("position", "m"),
+    field<&DeviceRow::gimbal>("gimbal", "rad", {"order", "roll, pitch, yaw"}),
+    field<&DeviceRow::buttons>("buttons", "1"),
+    field<&DeviceRow::force>("force", "N"),
+    field<&DeviceRow::overrun>("overrun", "1"),
+};
+
+inline constexpr Field<DeviceCounterRow> kDeviceCounterFields[] = {
+    field<&DeviceCounterRow::sequence>("sequence", "1"),
+    field<&DeviceCounterRow::new_samples>("new_samples", "1"),
+};
+
 // One column as recordings/README.md documents it: "/servo/fingers/<finger>/hip", with the
 // README's placeholders <finger> and <object> for the names.
 struct ColumnDoc {
@@ -185,7 +226,8 @@ struct ColumnDoc {
   Note note;
 };
 
-// Every column TraceRecorder writes, in the order it declares them (one finger, one object).
+// Every column TraceRecorder and DeviceRecorder write, in the order they declare them (one
+// finger, one object, one device with counters).
 std::vector<ColumnDoc> recorded_columns();
 
 }  // namespace graspsim::recordings::schema
