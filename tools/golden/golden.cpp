@@ -7,7 +7,6 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
-#include <utility>
 
 #include "graspsim/recordings/trace_decimate.hpp"
 #include "graspsim/recordings/trace_reader.hpp"
