@@ -78,9 +78,9 @@ app::RunOptions options_for(const app::DevicePlan& plan, const app::DeviceRegist
                             const scripting::Scenario& scenario, const std::string& out) {
   app::RunOptions o;
   o.out = kTmp + "/" + out + ".h5";
-  o.record_devices = plan.recorded();
-  o.script_alongside = plan.script_alongside;
-  o.make_device = [&plan, &registry, &scenario](std::size_t f) { return app::make_device(plan, registry, scenario, f); };
+  o.devices.record = plan.recorded();
+  o.devices.script_alongside = plan.script_alongside;
+  o.devices.make = [&plan, &registry, &scenario](std::size_t f) { return app::make_device(plan, registry, scenario, f); };
   return o;
 }
 
@@ -313,8 +313,8 @@ TEST_CASE("Every device is released (zero force) at the end, on a device error a
       const std::int64_t at = how == "end" ? -1 : 7000;
       app::RunOptions o;
       o.out = kTmp + "/devices_release_" + how + ".h5";
-      o.interrupt = &interrupt;
-      o.make_device = [&](std::size_t f) -> std::unique_ptr<hw::Device> {
+      o.stop.interrupt = &interrupt;
+      o.devices.make = [&](std::size_t f) -> std::unique_ptr<hw::Device> {
         return std::make_unique<WatchedFinger>(scenario.make_trajectory(f), watch[f], f == 1 ? at : -1,
                                                how == "interrupt" ? &interrupt : nullptr);
       };
@@ -404,7 +404,7 @@ TEST_CASE("The force ramp scales rendered forces by t / ramp, leaves the engine 
   REQUIRE(app::run_scenario(scenario, plain).error.empty());
   app::RunOptions ramped = plain;
   ramped.out = kTmp + "/ramp_2s.h5";
-  ramped.force_ramp = 2.0;
+  ramped.devices.force_ramp = 2.0;
   REQUIRE(app::run_scenario(scenario, ramped).error.empty());
   CHECK(recordings::read_dataset(plain.out, "/physics/state_hash").bits ==
         recordings::read_dataset(ramped.out, "/physics/state_hash").bits);
@@ -450,14 +450,14 @@ TEST_CASE("A run with every finger on sim-phantom records its samples and replay
 
 TEST_CASE("A device trace written before the sample counter columns still replays bit for bit", "[e2e][devices][replay]") {
   // A device table without /devices/<finger>/sequence and new_samples, as a trace from a build
-  // without the sample counter has it (here: the same run with RunOptions::device_counters off,
+  // without the sample counter has it (here: the same run with RunOptions::Devices::counters off,
   // which writes exactly that table); its replay must write neither column, or compare refuses
   // the tables' different columns and the replay reports 'differs'.
   const auto scenario = scripting::Scenario::load(kLift);
   const app::DeviceRegistry registry = app::default_registry();
   const app::DevicePlan plan = app::plan_devices(scenario, {"thumb=sim-phantom"}, registry);
   app::RunOptions options = options_for(plan, registry, scenario, "devices_old_schema");
-  options.device_counters = false;
+  options.devices.counters = false;
   const app::RunResult run = app::run_scenario(scenario, options);
   REQUIRE(run.error.empty());
   CHECK_THROWS(recordings::read_dataset(options.out, "/devices/thumb/sequence"));

@@ -222,7 +222,7 @@ TEST_CASE("recordings/README.md documents exactly the datasets and attributes of
   app::RunOptions options;
   options.out = kTmp + "/e2e_schema.h5";
   options.overrides = load.sets;
-  options.record_devices = {false, true};   // the index finger's samples in /devices/index
+  options.devices.record = {false, true};   // the index finger's samples in /devices/index
   const app::RunResult result = app::run_scenario(scenario, options);
   REQUIRE(result.error.empty());
 
