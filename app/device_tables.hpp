@@ -2,6 +2,8 @@
 // the device gave it, in its own frame, with the force sent to it in that frame, its own clock
 // and sample numbers, and the tick's overrun flag. What a device has of these it says through
 // the device interface (hw::Device: sample_time, sample_sequence, device_frame_sample, ...).
+// The columns are recordings::DeviceRecorder's (its field tables in trace_schema.hpp); this
+// class only gathers each row from the device.
 #pragma once
 
 #include <cstddef>
@@ -11,6 +13,7 @@
 
 #include "graspsim/engine/model.hpp"
 #include "graspsim/hw/device.hpp"
+#include "graspsim/recordings/device_recorder.hpp"
 #include "graspsim/recordings/trace_writer.hpp"
 
 namespace graspsim::app {
@@ -28,13 +31,10 @@ class DeviceTables {
               const std::vector<hw::Vec3>& rendered, bool overrun);
 
  private:
-  static constexpr std::size_t kNoColumn = static_cast<std::size_t>(-1);
   struct Table {
     std::size_t finger;   // Model::fingers index
     const hw::Device* device;
-    recordings::TraceTable* table;
-    std::size_t tick, time, device_time, position, gimbal, buttons, force, overrun;   // row offsets
-    std::size_t sequence = kNoColumn, new_samples = kNoColumn;   // row offsets (kNoColumn: not written)
+    recordings::DeviceRecorder recorder;
   };
   std::vector<Table> tables_;
   int rate_servo_ = 1;   // Hz

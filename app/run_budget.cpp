@@ -10,18 +10,11 @@
 #include <fstream>
 #include <sstream>
 
+#include "graspsim/recordings/device_recorder.hpp"
 #include "graspsim/recordings/trace_recorder.hpp"
 
 namespace graspsim::app {
 namespace {
-
-// One /devices/<finger> row as run.cpp's device_columns declares it: tick and buttons (int64),
-// time, device_time, position, gimbal and force (11 float64) and overrun (int8), 14 values in
-// 105 bytes; the counters sequence and new_samples (int64) add 2 values and 16 bytes.
-// tests/e2e/test_run_budget.cpp checks it against a written table.
-recordings::RowSize device_row(bool counters) {
-  return counters ? recordings::RowSize{16, 121} : recordings::RowSize{14, 105};
-}
 
 std::string bytes_text(double bytes) {
   const char* units[] = {"bytes", "kB", "MB", "GB", "TB", "PB", "EB"};
@@ -54,7 +47,7 @@ RunFootprint estimate_footprint(const scripting::Scenario& scenario, const RunOp
   table("/haptic", rows.haptic, static_cast<double>(d.haptic));
   table("/physics", rows.physics, static_cast<double>(d.physics));
   for (std::size_t f = 0; f < options.devices.record.size() && f < model.fingers.size(); ++f)
-    if (options.devices.record[f]) table("/devices/" + model.fingers[f].name, device_row(options.devices.counters), 1.0);
+    if (options.devices.record[f]) table("/devices/" + model.fingers[f].name, recordings::DeviceRecorder::row_size(options.devices.counters), 1.0);
   const double pool = options.trace.background_writer ? 4.0 : 1.0;   // TraceTable's blocks (trace_writer.cpp)
   double largest = -1.0;
   for (const TableFootprint& t : out.tables) {

@@ -61,8 +61,8 @@ std::vector<hw::Vec3> rows(const recordings::Dataset& d) {
 // its storage S holds the estimate E with at most one chunk C to spare: E <= S < E + C, per table,
 // and each table's row is the stored compound type's size exactly. Swept over three durations of
 // the lift (1.5 s, 2.34 s: a partly filled last chunk, 4 s), and with one finger on a replayed
-// device (its /devices table, 121-byte rows with the counters: run_budget.cpp's count of
-// run.cpp's columns).
+// device (its /devices table, 121-byte rows with the counters: DeviceRecorder::row_size, the
+// sum of its field tables, against the table the runner wrote through it).
 TEST_CASE("the disk estimate is every table's rows at their stored size, within one chunk of the file's "
           "storage", "[e2e][run_budget]") {
   const scripting::Scenario recorded = lift({});
