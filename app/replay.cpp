@@ -177,9 +177,17 @@ ReplayPlan load(const std::string& trace, const ReplayOptions& options) {
                       std::to_string(recordings::kSchemaVersion) + ")");
   }
   plan.status = required_string(trace, "status");
-  // The run's force ramp (absent: 0, no ramp): rendered forces again.
-  if (recordings::has_attribute(trace, "/", "force_ramp"))
-    plan.force_ramp = recordings::read_double_attribute(trace, "/", "force_ramp");
+  // A trace whose run scaled its rendered forces by a start ramp of its own (root `force_ramp`
+  // > 0, s): the one force ramp is a device's force safety, which a run does not record, so the
+  // replay renders the demand clamped, and its /servo force differs from the recording's for
+  // the first force_ramp seconds. The engine never saw that ramp.
+  if (recordings::has_attribute(trace, "/", "force_ramp")) {
+    const double ramp = recordings::read_double_attribute(trace, "/", "force_ramp");
+    if (ramp > 0.0)
+      plan.notes.push_back("the recording scaled rendered forces by a start ramp of " + std::to_string(ramp) +
+                           " s outside force safety, which this replay does not: /servo force differs until then "
+                           "(the engine is unchanged)");
+  }
   plan.scenario_path = required_string(trace, "scenario_path");
   plan.scenario_source_hash = required_string(trace, "scenario_source_hash");
   const std::string source = required_string(trace, "scenario_source");
@@ -336,7 +344,6 @@ RunOptions ReplayPlan::run_options(const std::string& out) const {
   options.out = out;
   options.overrides = overrides;
   options.stop.max_ticks = recorded_ticks;
-  options.devices.force_ramp = force_ramp;
   options.attributes.emplace_back("replay_of", replay_of());
   options.inputs.push_back({trace, "the trace replayed"});
   for (const RecordedFinger& r : fingers) {

@@ -74,7 +74,6 @@ struct ReplayPlan {
   std::int64_t recorded_ticks = 0;        // servo ticks with a sample for every finger
   std::int64_t scenario_ticks = 0;        // duration * rate_servo of the (overridden) scenario
   bool what_if = false;                   // ReplayOptions::sets was not empty
-  double force_ramp = 0.0;                // s: the recorded run's force ramp (root `force_ramp`)
   std::vector<std::string> notes;         // e.g. a cut trace replayed up to its last tick
   // The root attribute a replay trace carries: "<trace as given>\n<its scenario_source_hash>".
   std::string replay_of() const;

@@ -58,11 +58,6 @@ struct RunOptions {
     // the run (or draws from math.random) sees the same whatever drives the finger, and a session
     // replays bit for bit. In a paced run the script thread computes it (no Lua on the loop).
     std::vector<bool> script_alongside;
-    // The start ramp (s, 0: none; hw::ramp_in, force_safety.hpp): rendered forces scaled by
-    // min(1, t / force_ramp) from t = 0 (graspsim run: kForceRamp with a real device). Only what
-    // devices render changes, never the engine; root attribute `force_ramp`, which a replay
-    // applies again.
-    double force_ramp = 0.0;
   } devices;
 
   // Real-time pacing (pacer.hpp), with a real device attached: a null pacer runs as fast as

@@ -44,7 +44,6 @@ void Run::check_stability_before() {
   // the model's.
   stability_.before_run();
   trace_.set_attribute("warnings", stability_.text());
-  trace_.set_attribute("force_ramp", options_.devices.force_ramp);
 }
 
 void Run::open_devices() {
@@ -147,9 +146,10 @@ void Run::capture_initial(std::int64_t n) {
 }
 
 void Run::render() {
-  // The step's forces leave now, scaled by the start ramp at the tick's time.
+  // The step's forces leave now; each device clamps them to its limits, and a device with a
+  // motor model ramps them in and derates them (force safety, force_safety.hpp).
   for (std::size_t f = 0; f < devices_.size(); ++f)
-    rendered_[f] = devices_[f]->render(hw::ramp_in(record_.servo[f].force, tick_time_, options_.devices.force_ramp));
+    rendered_[f] = devices_[f]->render(record_.servo[f].force);
 }
 
 void Run::pace(std::int64_t n) {

@@ -40,7 +40,7 @@ class Run {
   void capture_initial(std::int64_t n);   // tick 0: the state expectations compare with
   void check_expectations(std::int64_t n) { expectations_->at_tick(n, *sim_, record_, slip_); }
   void step() { sim_->step(input_, record_); }
-  void render();                          // forces to every device, through the start ramp
+  void render();                          // forces to every device
   void pace(std::int64_t n);              // wait for the deadline; a stall releases and throws
   void record(std::int64_t n);            // /devices rows, then one row per loop that ran
   void flush(std::int64_t n) { trace_.flush_if_due(n); }

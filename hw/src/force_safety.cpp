@@ -30,11 +30,6 @@ double ramp_fraction(double elapsed, double rise_time) {
   return rise_time > 0.0 ? std::clamp(elapsed / rise_time, 0.0, 1.0) : 1.0;
 }
 
-Vec3 ramp_in(const Vec3& demand, double time, double rise_time) {
-  const double r = ramp_fraction(time, rise_time);
-  return r < 1.0 ? Vec3(r * demand) : demand;   // over: the demand itself, not 1.0 times it
-}
-
 namespace {
 void require(bool ok, const char* field, double value, const char* rule) {
   if (!ok)

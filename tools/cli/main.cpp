@@ -308,7 +308,6 @@ int run_command(const std::vector<std::string>& args) {
   if (plan.any_real()) {
     pacer.emplace(steady, scenario->model().rates.servo, graspsim::app::kStallTimeout);
     options.pacing.pacer = &*pacer;
-    options.devices.force_ramp = graspsim::app::kForceRamp;
     const std::string why = graspsim::app::probe_realtime();
     options.pacing.realtime = why.empty();
     if (!why.empty()) std::cerr << "graspsim: warning: " << why << "\n";

@@ -1,11 +1,13 @@
 // Force safety, in one place: every rule a force obeys on its way to a device.
 //   0. Device::render clamps every force to the device's limits (clamp_force below), and
 //      Device::release renders zero; the run loop releases every device when it stalls, falls
-//      behind, fails or ends. A run may scale the demand by a start ramp first (ramp_in).
+//      behind, fails or ends.
 // Inside a backend with a motor model, ForceSafety then holds each force to the current limit:
 //   1. clamped to the peak limit (clamp_force: NaN or infinite requests render zero),
 //   2. derated by a thermal model so the continuous limit holds in the long run,
-//   3. ramped in over a rise time after start (and after every stall or release),
+//   3. ramped in over a rise time after start (and after every stall or release): the one force
+//      ramp, a limit that rises from 0 to P, so no force jumps on, and one below the ramping
+//      limit is rendered whole (a hand's small corrections act from the start),
 //   4. zero when no request came for `stall_timeout` of the device clock, and after release().
 // It is driven by an injected time (s, the device's own clock); it never reads a clock.
 //
@@ -37,14 +39,9 @@ struct DeviceLimits {
 // fault is no force).
 Vec3 clamp_force(const Vec3& force, const DeviceLimits& limits);
 
-// The ramp law, one for every force ramp: the fraction of full force a time `elapsed` (s) after
-// a ramp starts, r = min(1, elapsed / T_rise) for elapsed >= 0, and 1 when T_rise = 0 (no ramp).
+// The ramp law: the fraction of the peak the limit allows a time `elapsed` (s) after the ramp
+// starts, r = min(1, elapsed / T_rise) for elapsed >= 0, 0 before, and 1 when T_rise = 0 (no ramp).
 double ramp_fraction(double elapsed, double rise_time);
-
-// A run's start ramp (graspsim run with a real device: 0.5 s, the trace's root `force_ramp`):
-// the demand scaled by ramp_fraction(t, T_rise) from t = 0, before the device's clamp, so a hand
-// that starts inside an object is pushed gently first. The demand itself once the ramp is over.
-Vec3 ramp_in(const Vec3& demand, double time, double rise_time);
 
 struct ForceSafetyConfig {
   double peak_force = 8.5;               // N: P, the largest force ever rendered
