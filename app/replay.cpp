@@ -99,7 +99,7 @@ class DeviceRowsReplay final : public hw::Device {
   bool overrun_ = false;
 };
 
-// The `mapping` attribute run.cpp writes: "identity ..." or "scale S; offset X Y Z m; rotation R P Y rad"
+// The `mapping` attribute device_tables.cpp writes: "identity ..." or "scale S; offset X Y Z m; rotation R P Y rad"
 // with every number at 17 significant digits, so it parses back to the same doubles.
 bool parse_mapping(const std::string& text, hw::WorkspaceMapping& m) {
   if (text.rfind("identity", 0) == 0) return false;

@@ -87,7 +87,7 @@ struct PacedRun {
   std::int64_t forbidden_uses = 0;
 };
 
-// Runs `scenario` paced on a fake clock, its fingers scripted (run.cpp's own ScriptedFinger),
+// Runs `scenario` paced on a fake clock, its fingers scripted (the run loop's own ScriptedFinger),
 // the loop's thread forbidden to enter Lua.
 PacedRun run_paced(const scripting::Scenario& scenario, const std::string& out) {
   FakeClock clock;
