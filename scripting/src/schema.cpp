@@ -398,7 +398,7 @@ FingerParts finger(const LuaValue& value, std::size_t index) {
   }
   if (const LuaValue* device = r.get("device")) {
     // The device's default spec and workspace mapping (world = offset + scale R p); the spec's
-    // syntax is checked by the CLI's device factory, which knows the kinds (tools/app/devices.cpp).
+    // syntax is checked by the CLI's device factory, which knows the kinds (app/devices.cpp).
     const Record d(*device, r.at("device"), TableKind::kDevice);
     out.setup.device = d.string_or("default", out.setup.device);
     if (out.setup.device.empty()) fail(d.at("default"), "must not be empty (\"scripted\", \"sim-phantom\", ...)");
