@@ -1,5 +1,5 @@
 -- corner_drop: a cube dropped corner first onto a stiff penalty floor, a hard case of the benchmark
--- (tools/bench/cases.hpp, corner_drop; README.md, "Speed against error").
+-- (bench/cases.hpp, corner_drop; README.md, "Speed against error").
 --
 -- cube_settle's 10 cm, 0.5 kg cube, dropped corner first from 1 cm, onto a floor a thousand times
 -- stiffer (100 kN/m per vertex, 20 N s/m) with physics at 1 kHz. The explicit (symplectic Euler)

@@ -1,4 +1,4 @@
-// The laws behind the benchmark's contact accuracy scenes (tools/bench/contact_accuracy.hpp):
+// The laws behind the benchmark's contact accuracy scenes (bench/contact_accuracy.hpp):
 // that each scene is built as it says (where the cube rests, which way the slope runs, how many
 // physics steps the cost is divided by), checked where the answer is known exactly. The scenes'
 // accuracy itself is measured by graspsim_bench, not asserted here. Engine only.

@@ -1,4 +1,4 @@
-// The laws behind the benchmark's hard cases (tools/bench/cases.hpp; README.md, "Speed against
+// The laws behind the benchmark's hard cases (bench/cases.hpp; README.md, "Speed against
 // error"): the intermediate-axis flip period against the elliptic-integral period, no energy
 // growth for the implicit gyroscopic term within its bound, the heavy top's precession rate, and
 // the corner drop's stability boundary with the detector the bench uses. Engine only.

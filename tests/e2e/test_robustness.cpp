@@ -7,7 +7,7 @@
 //   - the run reaches its end (no divergence, no script error);
 //   - no recorded quantity of any loop is NaN or infinite (every column of the trace);
 //   - no body leaves its scene: its centre stays within 1 m of where it started and above the
-//     floor less 1 cm (tools/bench/robustness.hpp says why those bounds);
+//     floor less 1 cm (bench/robustness.hpp says why those bounds);
 //   - no body's motion reverses at every physics step (a period-2 cycle, 8 steps in a row: the
 //     step's Nyquist mode, no motion of these scenes; robustness.hpp).
 // A check that cannot hold under a perturbation for a physical reason (the offset is larger than

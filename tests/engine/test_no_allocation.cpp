@@ -10,7 +10,7 @@
 #include "graspsim/engine/state_hash.hpp"
 #include "tests/engine/harness.hpp"
 #include "tests/engine/shapes.hpp"
-#include "tools/bench/mesh_grasp_scene.hpp"
+#include "bench/mesh_grasp_scene.hpp"
 
 #include "tests/support/count_allocations.hpp"
 
@@ -256,7 +256,7 @@ TEST_CASE("a step with body-body contact allocates no heap memory", "[schedule][
   CHECK(touching > 10);   // the falling box landed
 }
 
-// The real-time profile's scene (tools/bench/mesh_grasp_scene.hpp): three fingers close on a
+// The real-time profile's scene (bench/mesh_grasp_scene.hpp): three fingers close on a
 // 5,120-triangle mesh pebble resting on the floor (entry through the face tree, the walk over
 // triangles), lift it and hold it, a box resting untouched nearby; with sleep off and on (the
 // pebble and the box fall asleep while the fingers close, and the pebble wakes at the touch).

@@ -8,7 +8,7 @@
 
 #include "graspsim/engine/state_hash.hpp"
 #include "tests/engine/harness.hpp"
-#include "tools/bench/mesh_grasp_scene.hpp"
+#include "bench/mesh_grasp_scene.hpp"
 
 using namespace graspsim;
 
@@ -204,7 +204,7 @@ TEST_CASE("sleep is part of the state and deterministic", "[sleep][determinism]"
 
 // Sleep changes a run only while a body sleeps, and then only by how far the awake body would have
 // crept: a run's outcome with sleep equals the one without within that.
-//  - The profile's scene (tools/bench/mesh_grasp_scene.hpp): the pebble starts at rest (speeds
+//  - The profile's scene (bench/mesh_grasp_scene.hpp): the pebble starts at rest (speeds
 //    ~1e-16), sleeps from 0.5 s until the fingers touch it at 1.4 s, is lifted 3 cm and held.
 //    Awake, it creeps by ~1e-16 m/s x 1 s: the two final poses agree to 1e-9 m and 1e-9 rad
 //    (rounding grown through 2.6 s of grasp; 1/30,000,000 of the lift).

@@ -13,7 +13,7 @@
 #include <vector>
 
 #include "app/replay.hpp"
-#include "golden/golden.hpp"
+#include "app/golden.hpp"
 #include "graspsim/recordings/trace_reader.hpp"
 #include "graspsim/scripting/scenario.hpp"
 #include "tests/support/shell.hpp"

@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "golden/golden.hpp"
+#include "app/golden.hpp"
 #include "graspsim/recordings/trace_reader.hpp"
 
 #ifndef GRASPSIM_SOURCE_DIR

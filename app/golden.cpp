@@ -1,5 +1,5 @@
 // Golden traces: run, decimate, compare (see golden.hpp and README.md, "Golden traces").
-#include "golden/golden.hpp"
+#include "app/golden.hpp"
 
 #include <algorithm>
 #include <cinttypes>
