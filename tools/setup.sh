@@ -1,9 +1,12 @@
-# Shared set-up for tools/graspsim and tools/check: install the Debian packages that are
-# missing, configure once, build incrementally. Sourced, not run; idempotent.
-# Environment: GRASPSIM_BUILD_DIR (default build), GRASPSIM_BUILD_TYPE (default Release).
+# Shared set-up for tools/graspsim, tools/check and tools/fuzz: install the Debian packages that
+# are missing, configure once, build incrementally. Sourced, not run; idempotent.
+# Environment: GRASPSIM_BUILD_DIR (default build), GRASPSIM_BUILD_TYPE (default Release),
+# GRASPSIM_SANITIZE_BUILD_DIR (default build-sanitize).
 
 graspsim_root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 graspsim_build=${GRASPSIM_BUILD_DIR:-$graspsim_root/build}
+graspsim_cmake_env=()    # e.g. CC=clang CXX=clang++, for the first configure only
+graspsim_cmake_args=()   # extra -D options, for the first configure only
 
 # Everything graspsim needs from Debian 12, and nothing else. hdf5-tools gives h5dump and
 # h5ls for looking into traces.
@@ -13,6 +16,8 @@ graspsim_packages=(
   hdf5-tools
   python3-h5py python3-matplotlib   # tools/plot_trace.py; h5py also reads crash-cut traces in
                                     # SWMR mode in tests/e2e/test_crash.cpp
+  clang libclang-rt-dev             # the Clang twin, the sanitizer build (its runtimes) and
+                                    # libFuzzer (README.md "Sanitizers and fuzzing")
 )
 
 graspsim_install_missing() {
@@ -51,8 +56,8 @@ graspsim_build() {
   mkdir -p "$graspsim_build" && : >"$log"
   if [ ! -f "$graspsim_build/CMakeCache.txt" ]; then
     echo "graspsim: first build, in $graspsim_build (a few minutes; log: $log)" >&2
-    cmake -S "$graspsim_root" -B "$graspsim_build" \
-      -DCMAKE_BUILD_TYPE="${GRASPSIM_BUILD_TYPE:-Release}" >>"$log" 2>&1 \
+    env "${graspsim_cmake_env[@]}" cmake -S "$graspsim_root" -B "$graspsim_build" \
+      -DCMAKE_BUILD_TYPE="${GRASPSIM_BUILD_TYPE:-Release}" "${graspsim_cmake_args[@]}" >>"$log" 2>&1 \
       || { cat "$log" >&2; echo "graspsim: configuring failed (log: $log)" >&2; return 1; }
   fi
   local targets=()
@@ -63,6 +68,15 @@ graspsim_build() {
     echo "graspsim: build failed (log: $log)" >&2
     return 1
   fi
+}
+
+# graspsim_use_sanitize_build: later graspsim_build calls build the sanitizer build instead, a
+# Clang build with AddressSanitizer, UndefinedBehaviorSanitizer and the fuzzers (GRASPSIM_SANITIZE
+# in CMakeLists.txt), without the twins the main build already tests.
+graspsim_use_sanitize_build() {
+  graspsim_build=${GRASPSIM_SANITIZE_BUILD_DIR:-$graspsim_root/build-sanitize}
+  graspsim_cmake_env=(CC=clang CXX=clang++)
+  graspsim_cmake_args=(-DGRASPSIM_SANITIZE=ON -DGRASPSIM_TWIN_BUILD=OFF -DGRASPSIM_COMPILER_TWIN=OFF)
 }
 
 # graspsim_setup [TARGET...]
