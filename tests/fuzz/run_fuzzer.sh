@@ -4,7 +4,8 @@
 # FUZZER: the harness binary (its name picks corpus/<name> and <name>.dict in SOURCE_DIR).
 # SOURCE_DIR: tests/fuzz of the source tree.
 # WORK_DIR/<name>/corpus keeps the inputs it found (kept between runs: a longer run resumes);
-# a crashing input is written to WORK_DIR/<name>/ and named in the output.
+# a crashing input is written to WORK_DIR/<name>/ and named in the output, whose last line is
+# also left in WORK_DIR/<name>/summary.txt.
 # Exit 0: no finding. Otherwise libFuzzer's status (a crash, a sanitizer report, a timeout of one
 # input past 10 s, or more than 2 GB of memory).
 set -eu
@@ -30,9 +31,10 @@ status=0
 executions=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log" | tail -n 1)
 corpus=$(ls "$work/corpus" | wc -l)
 if [ "$status" -eq 0 ]; then
-  echo "$name: ${executions:-?} executions in $seconds s, no finding (corpus: $corpus inputs found, seeds in $seeds)"
+  summary="$name: ${executions:-?} executions in $seconds s, no finding (corpus: $corpus inputs kept)"
 else
   tail -n 80 "$log"
-  echo "$name: FINDING after ${executions:-?} executions (exit $status); the input is in $work/ (full log: $log)"
+  summary="$name: FINDING after ${executions:-?} executions (exit $status); the input is in $work/ (log: $log)"
 fi
+echo "$summary" | tee "$work/summary.txt"
 exit "$status"
