@@ -1,5 +1,5 @@
 -- corner_drop: a cube dropped corner first onto a stiff penalty floor, a hard case of the benchmark
--- (issue 5; tools/bench/cases.hpp, corner_drop; README.md, "Speed against error").
+-- (tools/bench/cases.hpp, corner_drop; README.md, "Speed against error").
 --
 -- cube_settle's 10 cm, 0.5 kg cube, dropped corner first from 1 cm, onto a floor a thousand times
 -- stiffer (100 kN/m per vertex, 20 N s/m) with physics at 1 kHz. The explicit (symplectic Euler)
@@ -8,7 +8,7 @@
 -- 50 Hz), so 1e5 is stable: the cube lands, rotates down onto a face and rests m g / (4 k) = 12 um
 -- deep. It keeps a period-2 tangential cycle: its centre alternates by 2.4 um between two points
 -- every physics step (1.7 mm/s), the floor's friction anchors slipping in a friction circle only
--- mu m g / (4 k) = 7 um wide; no creep (found by this scenario; engine/README.md, Limits). That
+-- mu m g / (4 k) = 7 um wide; no creep (engine/README.md, "Limits"). That
 -- is the paper's step (--set integrator=paper); the implicit one, the default, rests the cube at
 -- any stiffness. Try --set integrator=paper --set stiffness=3e6: the explicit step blows up, and
 -- the energy watch (engine/energy.hpp) stops the run at the physics tick the cube's energy passes

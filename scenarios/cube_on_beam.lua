@@ -1,4 +1,4 @@
--- cube_on_beam: polygon-polygon contact by a clipped contact manifold (issue 3, item 9).
+-- cube_on_beam: polygon-polygon contact by a clipped contact manifold (engine/README.md, "Shapes").
 --
 -- An 8 cm, 0.4 kg cube is set down across a 40 cm beam 4 cm wide lying on the floor. The cube's
 -- corners overhang the beam on both sides and the beam's ends lie far outside the cube: no vertex

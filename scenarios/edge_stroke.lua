@@ -1,5 +1,5 @@
--- edge_stroke: polygon boundary traversal (issue 3, item 7; the paper's section 6 names its
--- absence as a limit).
+-- edge_stroke: polygon boundary traversal (the paper's section 6 names its absence as a
+-- limit).
 --
 -- A finger with a 4 mm spherical pad presses 2 mm into the top face of a ring (the non-convex
 -- triangle mesh scenarios/meshes/ring.obj: 12 mm square section round a 16-gon of radius 30 mm,

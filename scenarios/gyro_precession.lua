@@ -1,5 +1,5 @@
 -- gyro_precession: a fast top on a point held by a stiff spring precesses at the analytic rate,
--- a hard case of the benchmark (issue 5; tools/bench/cases.hpp, gyro_precession).
+-- a hard case of the benchmark (tools/bench/cases.hpp, gyro_precession).
 --
 -- A 1 kg box, 10 x 10 x 4 cm (a square flat "top", symmetry axis body z), stands on a point finger
 -- at its bottom face's centre (the pivot, l = 2 cm below the centre of mass), its axis tilted 30

@@ -1,5 +1,5 @@
 -- heavy_hold: two 5 kg boxes, each pinched by two fingers just above and just below the slip
--- threshold 2 mu k d = m g, lifted 3 cm (issue 5, item 2; Coulomb's law of section 2).
+-- threshold 2 mu k d = m g, lifted 3 cm (a hard case; Coulomb's law of section 2).
 --
 -- Each 10 cm cube rests on a soft floor (1250 N/m per vertex: h^2 12 k / m = 1.2 at 50 Hz). Two
 -- fingers (k = 5000 N/m, 20 N s/m) press into its x faces d deep, mu = 0.5:

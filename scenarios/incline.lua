@@ -1,4 +1,4 @@
--- incline: static and kinetic friction on a plane tilted at theta (issue 3, item 8).
+-- incline: static and kinetic friction on a plane tilted at theta (engine/README.md, "Choices").
 --
 -- The floor stays z = 0 and gravity is tilted instead: g = 9.81 (sin theta, 0, -cos theta) is a
 -- plane tilted by theta = 25 degrees about y, downhill along +x. Two 8 x 8 x 4 cm, 0.4 kg boxes

@@ -1,5 +1,5 @@
 -- incline_threshold: two boxes on one incline, 2% either side of Coulomb's threshold tan(theta) = mu
--- (issue 5, item 2; the hard variant of incline.lua).
+-- (engine/README.md, "Hard cases"; the hard variant of incline.lua).
 --
 -- The floor stays z = 0 and gravity is tilted by theta = 25 degrees about y (downhill +x). Two
 -- flat 12 x 12 x 4 cm, 0.4 kg boxes, each with mu_k = mu_s (no static peak):

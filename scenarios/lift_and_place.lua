@@ -1,4 +1,4 @@
--- lift_and_place: pick a box up from the floor, set it on another box, let go (issue 3, item 5).
+-- lift_and_place: pick a box up from the floor, set it on another box, let go.
 --
 -- An 8 cm, 0.4 kg box stands on the floor; 25 cm away stands a 12 x 12 x 8 cm, 0.4 kg base. Thumb
 -- and index pinch the box from its sides (along y), lift it 12 cm, carry it over the base, 1 cm

@@ -1,5 +1,5 @@
 -- plate_push: a finger pushed hard down through a 2 mm plate lying on the floor never tunnels
--- through it (issue 5, item 2).
+-- through it (engine/README.md, "Hard cases").
 --
 -- A 10 x 10 x 0.2 cm, 0.15 kg plate lies on a floor of 2000 N/m per vertex (it rests 0.18 mm
 -- deep, inside its thickness). A finger (k = 300 N/m) comes down on its centre at 5 m/s, 1 cm per

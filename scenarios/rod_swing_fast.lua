@@ -1,5 +1,5 @@
 -- rod_swing_fast: the hard variant of rod_swing.lua: a 40 cm rod pinched 3 cm below its top is
--- swung fast, four times its own pendulum frequency (issue 5, item 2; section 6).
+-- swung fast, four times its own pendulum frequency (engine/README.md, "Hard cases"; section 6).
 --
 -- 40 x 4 x 4 cm, 0.4 kg; thumb and index pinch it 1.5 cm deep each side (k = 300 N/m: 4.5 N each,
 -- mu = 1). Two point contacts are a hinge (no torsion rule): the rod hangs from the grip as a

@@ -1,5 +1,5 @@
 -- spin_flip: the intermediate-axis theorem (Dzhanibekov effect), a hard case of the benchmark
--- (issue 5; tools/bench/cases.hpp, spin_flip).
+-- (tools/bench/cases.hpp, spin_flip).
 --
 -- A torque-free body with principal moments 1:2:3 kg m^2 is spun at 5 rad/s about its middle axis
 -- (body y) with 0.1 rad/s about the other two. Spin about the middle axis is unstable: the body

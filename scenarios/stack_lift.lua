@@ -1,4 +1,4 @@
--- stack_lift: a stack carried with no special code (issue 3, item 5, second half).
+-- stack_lift: a stack carried with no special code.
 --
 -- A flat 8 x 8 x 2 cm, 0.1 kg box rests on an 8 cm, 0.4 kg box on the floor. Thumb and index
 -- pinch the lower box, lift it 6 cm with a minimum-jerk motion and hold it. Nothing tells the

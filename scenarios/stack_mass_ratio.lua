@@ -1,6 +1,6 @@
 -- stack_mass_ratio: two stacks with a 100:1 mass ratio, light on heavy and heavy on light, let go
--- touching (springs relaxed, so the whole weight comes on as a step) and left to settle (issue 5,
--- item 2).
+-- touching (springs relaxed, so the whole weight comes on as a step) and left to settle
+-- (engine/README.md, "Hard cases").
 --
 -- Each stack: an 8 x 8 x 2 cm top box on a 16 x 16 x 4 cm bottom box on the floor.
 --   'light_on_heavy'  10 g on 1 kg, contact 400 N/m and 0.5 N s/m per point (set for the 10 g box:

@@ -11,14 +11,7 @@ namespace graspsim {
 EnergyWatch::EnergyWatch(const Model& model) : model_(model) {
   const std::size_t n = model.bodies.size();
   for (std::size_t b = 0; b < n; ++b) {
-    const BodyParams& bp = model.bodies[b];
-    double reach = 0.0;
-    for (int k = 0; k < floor_point_count(bp.shape); ++k) {
-      bool rolling = false;
-      reach = std::max(reach, floor_point(bp.shape, Mat3::Identity(), k, rolling).norm());
-    }
-    if (bp.shape.kind == ShapeKind::kCapsule) reach = bp.shape.half_length + bp.shape.radius;
-    reach_.push_back(reach);
+    reach_.push_back(floor_reach(model.bodies[b].shape));
     const double k = model.floor.enabled ? floor_pair(model, static_cast<int>(b)).stiffness : 0.0;
     floor_k_.push_back(std::isfinite(k) ? k : 0.0);
   }

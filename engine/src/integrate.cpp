@@ -1,5 +1,6 @@
 // Newton-Euler integration of one rigid body (paper, section 3.1), with the gyroscopic term of
-// Euler's equation neglected (the paper), explicit, or implicit (issue 3, item 1).
+// Euler's equation neglected (the paper), explicit, or implicit (README.md, "Speed against
+// error", measures the three).
 #include "graspsim/engine/integrate.hpp"
 
 #include <Eigen/LU>
@@ -78,7 +79,7 @@ void integrate_body(const BodyParams& params, Gyroscopic gyroscopic, BodyState& 
   // The gyroscopic change of w, computed in the body frame and added in the world frame,
   //   w = w_old + R dw_b(R^T w_old),
   // before the torque's change; for kNeglect nothing is added and the paper's update below runs
-  // on the same operands as before, bit for bit. Adding the change (not w = R w_b) leaves the
+  // on the paper's own operands, bit for bit. Adding the change (not w = R w_b) leaves the
   // part of w that does not change free of the R R^T round trip, and makes w = 0 give dw_b = 0
   // exactly, so all three options agree bit for bit on a body at rest.
   if (gyroscopic != Gyroscopic::kNeglect) {

@@ -57,6 +57,16 @@ Vec3 floor_point(const Shape& s, const Mat3& rotation, int k, bool& rolling) {
   return Vec3::Zero();
 }
 
+double floor_reach(const Shape& shape) {
+  if (shape.kind == ShapeKind::kCapsule) return shape.half_length + shape.radius;
+  double reach = 0.0;
+  for (int k = 0; k < floor_point_count(shape); ++k) {
+    bool rolling = false;
+    reach = std::max(reach, floor_point(shape, Mat3::Identity(), k, rolling).norm());
+  }
+  return reach;
+}
+
 namespace {
 
 // One floor point of a body at this step, as the penalty law sees it (paper, section 4).

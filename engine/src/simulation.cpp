@@ -39,17 +39,10 @@ Simulation::Simulation(Model model)
       implicit_(model_) {
   collision_.update(model_, state_);
   scratch_.reserve(model_.bodies.size());
-  // How far below its centre of mass a body can reach the floor: its farthest floor point (a
-  // rolling point is at radius r from a centre point; the capsule's at L + r), with 1e-9 to spare.
+  // How far below its centre of mass a body can reach the floor, with 1e-9 to spare.
   std::size_t floor_points = 0;
   for (const BodyParams& bp : model_.bodies) {
-    double reach = 0.0;
-    for (int k = 0; k < floor_point_count(bp.shape); ++k) {
-      bool rolling = false;
-      reach = std::max(reach, floor_point(bp.shape, Mat3::Identity(), k, rolling).norm());
-    }
-    if (bp.shape.kind == ShapeKind::kCapsule) reach = bp.shape.half_length + bp.shape.radius;
-    floor_reach_.push_back(reach * (1.0 + 1e-9) + 1e-12);
+    floor_reach_.push_back(floor_reach(bp.shape) * (1.0 + 1e-9) + 1e-12);
     floor_points += static_cast<std::size_t>(floor_point_count(bp.shape));
   }
   floor_clear_.assign(model_.bodies.size(), 0);

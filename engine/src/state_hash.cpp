@@ -21,8 +21,8 @@ static_assert(sizeof(PairPointContact) == 64, "PairPointContact changed: update 
 
 class Hasher {
  public:
-  // One 64-bit word per step (8 times fewer multiplies than feeding its bytes, which made the
-  // hash the largest logging cost at 3 kHz physics): FNV-1a's xor and multiply on the whole
+  // One 64-bit word per step (8 times fewer multiplies than feeding its bytes, which would make
+  // the hash the largest logging cost at 3 kHz physics): FNV-1a's xor and multiply on the whole
   // word, then an xor-shift. The multiply only carries a bit upward, so without the shift a
   // difference in a word's top bit (a sign) would stay in the top bit, and two of them (x and
   // y both negated) would cancel; the shift folds the top half down before the next word.
@@ -105,7 +105,8 @@ std::uint64_t state_hash(const State& s) {
     h.real(f.friction_radius);
     h.real(f.pitch_at_last_physics);
     h.flag(f.has_pitch);
-    // Only once set (implicit integrator), so that paper traces keep the hash they always had.
+    // Only once set (implicit integrator), so that a paper trace's hash does not depend on these
+    // fields (the goldens hold the paper's scheme).
     if (f.has_last_physics) {
       h.flag(f.has_last_physics);
       h.vec(f.hip_at_last_physics);

@@ -1,10 +1,18 @@
-// Force safety shared by every device.
+// Force safety and workspaces shared by every device.
 #include "graspsim/hw/device.hpp"
 
 #include <cmath>
 #include <limits>
 
 namespace graspsim::hw {
+
+bool Workspace::contains(const Vec3& p) const {
+  for (int i = 0; i < 3; ++i)
+    if (!(p[i] >= min[i] && p[i] <= max[i])) return false;
+  return true;
+}
+
+Workspace reach_box(double half_side) { return Workspace{Vec3::Constant(-half_side), Vec3::Constant(half_side)}; }
 
 Vec3 clamp_force(const Vec3& force, const DeviceLimits& limits) {
   const double limit = limits.max_force;

@@ -111,6 +111,11 @@ std::string SimPhantom::describe() const {
          std::to_string(static_cast<long long>(std::llround(config_.device_rate_hz))) + " Hz)";
 }
 
+Workspace SimPhantom::workspace() const {
+  const double margin = res_ > 0.0 ? res_ : 1e-9;   // m
+  return Workspace{lo_ - Vec3::Constant(margin), hi_ + Vec3::Constant(margin)};
+}
+
 Vec3 SimPhantom::hand_force() const {
   return config_.hand_stiffness * (hand_now_.position + u_ - x_);
 }

@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "graspsim/recordings/trace_writer.hpp"
+#include "h5_checks.hpp"
 
 namespace graspsim::recordings::h5 {
 namespace {
@@ -167,8 +168,13 @@ Member member_of(hid_t dataset, const std::string& name, const std::string& cont
     if (H5Tget_array_ndims(type.get()) != 1) throw TraceError(context + ": not a 1-D array member");
     hsize_t dims[1] = {0};
     check(H5Tget_array_dims2(type.get(), dims), context);
-    out.width = static_cast<std::size_t>(dims[0]);
     out.element = checked(H5Tget_super(type.get()), H5Tclose, context);
+    // A damaged type may claim any width: it must be sane and agree with the member's bytes.
+    const std::size_t element = H5Tget_size(out.element.get());
+    if (dims[0] < 1 || dims[0] > kMaxColumnWidth || element == 0 || dims[0] * element != H5Tget_size(type.get()))
+      throw TraceError(context + ": member '" + name + "' is an array of " + std::to_string(dims[0]) +
+                       " elements that does not fit its " + std::to_string(H5Tget_size(type.get())) + " bytes (damaged?)");
+    out.width = static_cast<std::size_t>(dims[0]);
   } else {
     out.element = std::move(type);
   }
@@ -207,6 +213,8 @@ std::string read_string_attribute(hid_t object, const std::string& name,
   const htri_t variable = H5Tis_variable_str(file_type.get());
   check(variable, where);
   if (variable > 0) {
+    // libhdf5 trusts the stored length and heap object of a variable-length string: check both.
+    check_variable_string(attribute.get(), name, context);
     Handle memory_type = string_type();
     check(H5Tset_cset(memory_type.get(), H5Tget_cset(file_type.get())), where);
     char* text = nullptr;
@@ -216,6 +224,8 @@ std::string read_string_attribute(hid_t object, const std::string& name,
     return value;
   }
   const std::size_t size = H5Tget_size(file_type.get());
+  if (size == 0 || size > file_size(attribute.get(), where))
+    throw TraceError(where + ": a fixed-length string of " + std::to_string(size) + " bytes cannot be in its file (damaged?)");
   Handle memory_type = checked(H5Tcopy(file_type.get()), H5Tclose, where);
   std::vector<char> buffer(size + 1, '\0');
   check(H5Aread(attribute.get(), memory_type.get(), buffer.data()), where);

@@ -13,7 +13,6 @@
 #include <bit>
 #include <cmath>
 #include <cstdio>
-#include <filesystem>
 #include <limits>
 #include <map>
 #include <optional>
@@ -22,6 +21,7 @@
 #include <variant>
 
 #include "h5.hpp"
+#include "h5_checks.hpp"
 
 namespace graspsim::recordings {
 namespace {
@@ -37,26 +37,11 @@ struct OpenTrace {
 };
 
 OpenTrace open_trace(const std::string& path) {
-  const std::string where = "cannot open trace " + quoted(path);
-  std::error_code ec;
-  if (!std::filesystem::exists(path, ec)) fail(where + ": no such file");
-  if (std::filesystem::is_directory(path, ec)) fail(where + ": it is a directory");
-  const htri_t is_hdf5 = H5Fis_hdf5(path.c_str());
-  if (is_hdf5 < 0) fail(where + ": " + h5::last_error());
-  if (is_hdf5 == 0) fail(where + ": not an HDF5 file");
+  h5::OpenFile opened = h5::open_read_only(path, "cannot open trace " + quoted(path));
   OpenTrace trace;
   trace.name = path;
-  hid_t id = H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
-  if (id < 0) {
-    // A file still marked open for writing (a SWMR writer that was killed) opens for SWMR
-    // reading, which skips that mark, as h5py's swmr=True does.
-    const std::string first_error = h5::last_error();
-    H5Eclear2(H5E_DEFAULT);
-    id = H5Fopen(path.c_str(), H5F_ACC_RDONLY | H5F_ACC_SWMR_READ, H5P_DEFAULT);
-    if (id < 0) fail(where + ": " + first_error + " (truncated or damaged?)");
-    trace.swmr = true;
-  }
-  trace.file = h5::Handle(id, H5Fclose);
+  trace.file = std::move(opened.file);
+  trace.swmr = opened.swmr;   // skipped the still-open mark, as h5py's swmr=True does
   return trace;
 }
 
@@ -82,6 +67,9 @@ std::string attribute_text(hid_t object, const std::string& name, const std::str
   h5::Handle space = h5::checked(H5Aget_space(attribute.get()), H5Sclose, context);
   const hssize_t n = H5Sget_simple_extent_npoints(space.get());
   const H5T_class_t type_class = H5Tget_class(type.get());
+  // A damaged dataspace may claim any count: 8 bytes each must fit in the file.
+  if (n < 0 || static_cast<std::uint64_t>(n) > h5::file_size(object, context) / 8)
+    fail(context + ": attribute " + quoted(name) + " claims " + std::to_string(n) + " elements (damaged?)");
   if (type_class == H5T_STRING && n == 1) return h5::read_string_attribute(object, name, context);
   if ((type_class == H5T_INTEGER || type_class == H5T_FLOAT) && n >= 1) {
     std::string text;
@@ -151,7 +139,7 @@ std::vector<std::string> top_groups(const OpenTrace& t) {
     const H5I_type_t type = object_type(t.file.get(), l, context);
     if (type == H5I_DATASET && is_table_dataset(t.file.get(), l, context)) groups.push_back(l);
     if (type != H5I_GROUP) continue;
-    // A group of tables (/devices/<finger>, issue 6) is compared table by table; any other
+    // A group of tables (/devices/<finger>) is compared table by table; any other
     // group (a schema 2 loop: one dataset per column) as one table.
     std::vector<std::string> children, tables;
     h5::Handle g = h5::checked(H5Gopen2(t.file.get(), l.c_str(), H5P_DEFAULT), H5Gclose,
@@ -289,6 +277,7 @@ Column open_column(const OpenTrace& t, const std::string& group, const std::stri
     if (H5Sget_simple_extent_ndims(space.get()) != 1) fail(context + ": its table is not 1-D");
     hsize_t rows[1] = {0};
     h5::check(H5Sget_simple_extent_dims(space.get(), rows, nullptr), context);
+    h5::check_rows(c.dataset.get(), rows[0], context);
     c.rows = static_cast<std::int64_t>(rows[0]);
   } else {
     c.dataset = h5::checked(H5Dopen2(t.file.get(), c.path.c_str(), H5P_DEFAULT), H5Dclose,
@@ -300,6 +289,8 @@ Column open_column(const OpenTrace& t, const std::string& group, const std::stri
       fail(context + ": has " + std::to_string(c.rank) + " dimensions (a trace column has 1 or 2)");
     hsize_t dims[2] = {0, 1};
     h5::check(H5Sget_simple_extent_dims(space.get(), dims, nullptr), context);
+    h5::check_rows(c.dataset.get(), dims[0], context);
+    if (dims[1] > h5::kMaxColumnWidth) fail(context + ": " + std::to_string(dims[1]) + " values per row (damaged?)");
     c.rows = static_cast<std::int64_t>(dims[0]);
     c.width = c.rank == 2 ? static_cast<std::size_t>(dims[1]) : 1;
   }
@@ -874,6 +865,8 @@ CompareResult compare_traces(const std::string& a, const std::string& b,
     throw;
   } catch (const TraceError& e) {
     throw CompareInputError(e.what());
+  } catch (const std::bad_alloc&) {
+    throw CompareInputError("comparing " + quoted(a) + " and " + quoted(b) + ": not enough memory");
   }
 }
 

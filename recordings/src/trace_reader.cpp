@@ -4,6 +4,7 @@
 #include <algorithm>
 
 #include "h5.hpp"
+#include "h5_checks.hpp"
 
 namespace graspsim::recordings {
 namespace {
@@ -11,18 +12,7 @@ namespace {
 std::string quoted(const std::string& text) { return "'" + text + "'"; }
 
 h5::Handle open_file(const std::string& file) {
-  const std::string where = "cannot open trace " + quoted(file);
-  const htri_t is_hdf5 = H5Fis_hdf5(file.c_str());
-  if (is_hdf5 < 0) throw TraceError(where + ": " + h5::last_error());
-  if (is_hdf5 == 0) throw TraceError(where + ": not an HDF5 file");
-  const hid_t plain = H5Fopen(file.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
-  if (plain >= 0) return h5::Handle(plain, H5Fclose);
-  // A trace still being written, or cut by a crash, is marked as open for SWMR writing: it
-  // opens as a SWMR reader (recordings/README.md, "Crash safety").
-  const std::string reason = h5::last_error();
-  const hid_t swmr = H5Fopen(file.c_str(), H5F_ACC_RDONLY | H5F_ACC_SWMR_READ, H5P_DEFAULT);
-  if (swmr >= 0) return h5::Handle(swmr, H5Fclose);
-  throw TraceError(where + ": " + reason);
+  return h5::open_read_only(file, "cannot open trace " + quoted(file)).file;
 }
 
 DType dtype_of(hid_t type, const std::string& context) {
@@ -122,9 +112,8 @@ void read_member(hid_t dataset, const std::string& member, hid_t element, std::s
             context + ": cannot read");
 }
 
-}  // namespace
-
-Dataset read_dataset(const std::string& file, const std::string& path) {
+// read_dataset, but for running out of memory (a bound read_dataset turns into a TraceError).
+Dataset read_dataset_checked(const std::string& file, const std::string& path) {
   h5::Lock lock;
   h5::Quiet quiet;
   const std::string context = "trace " + quoted(file) + ", dataset " + quoted(path);
@@ -140,6 +129,8 @@ Dataset read_dataset(const std::string& file, const std::string& path) {
   std::vector<hsize_t> dims(static_cast<std::size_t>(rank));
   if (rank > 0) h5::check(H5Sget_simple_extent_dims(space.get(), dims.data(), nullptr), context);
 
+  // Its extent, before anything is allocated for it: a damaged one may claim 2^64 rows.
+  if (rank > 0) h5::check_rows(where.object.get(), dims[0], context);
   Dataset out;
   if (!where.member.empty()) {
     // A column of a table: shape (n,) or (n, width).
@@ -190,6 +181,16 @@ Dataset read_dataset(const std::string& file, const std::string& path) {
     out.units = h5::read_string_attribute(where.object.get(), "units", context);
   }
   return out;
+}
+
+}  // namespace
+
+Dataset read_dataset(const std::string& file, const std::string& path) {
+  try {
+    return read_dataset_checked(file, path);
+  } catch (const std::bad_alloc&) {
+    throw TraceError("trace " + quoted(file) + ", dataset " + quoted(path) + ": not enough memory to read it");
+  }
 }
 
 namespace {

@@ -32,6 +32,20 @@ std::size_t chunk_rows(std::int64_t chunk_ticks, std::int64_t divisor) {
 
 }  // namespace
 
+// Counted from the columns the constructor declares (tests/recordings/test_trace_recorder.cpp
+// checks both against a written file): tick and time (int64, float64) in every table; per
+// finger, 4 vectors in /servo, and 3 vectors and 3 scalars (12 float64), an int8 and an int32
+// in /haptic; the state hash (uint64), then per body 5 vectors, a quaternion and 3 scalars (22
+// float64) and 2 int32 in /physics.
+TraceRecorder::Rows TraceRecorder::row_sizes(const graspsim::Model& model) {
+  const std::size_t f = model.fingers.size(), b = model.bodies.size();
+  Rows r;
+  r.servo = {2 + 12 * f, 16 + 96 * f};
+  r.haptic = {2 + 14 * f, 16 + (12 * 8 + 1 + 4) * f};
+  r.physics = {3 + 24 * b, 24 + (22 * 8 + 2 * 4) * b};
+  return r;
+}
+
 TraceRecorder::TraceRecorder(TraceWriter& writer, const graspsim::Model& model,
                              std::int64_t chunk_ticks)
     : servo_(writer.table("servo", chunk_rows(chunk_ticks, 1))),

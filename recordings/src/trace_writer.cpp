@@ -385,7 +385,7 @@ std::size_t TraceTable::add_column(const std::string& path, int width, DType dty
   if (width < 1) throw TraceError(t.column_context(path) + ": width must be at least 1");
   for (const Column& c : t.columns) {
     if (c.name == path) throw TraceError(t.column_context(path) + ": column declared twice");
-    // Column paths form a tree, as datasets in groups did (schema 2): "a" and "a/b" cannot both
+    // Column paths form a tree, as datasets in groups would (schema 2): "a" and "a/b" cannot both
     // be columns, or "/t/a" would name both a column and a group of columns.
     if (c.name.rfind(path + "/", 0) == 0 || path.rfind(c.name + "/", 0) == 0) {
       throw TraceError(t.column_context(path) + ": column path clashes with column " +

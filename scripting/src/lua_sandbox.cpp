@@ -8,6 +8,7 @@
 #include <lua.hpp>
 
 #include "lua_convert.hpp"
+#include "lua_patterns.hpp"
 
 namespace graspsim::scripting {
 namespace {
@@ -124,6 +125,9 @@ int open_libraries(lua_State* state) {
   lua_pushnil(state);
   lua_setfield(state, -2, "dump");
   lua_pop(state, 1);
+  // The pattern functions, string.rep and table.move do unbounded work in C, where the count
+  // hook never runs: these versions charge it to the budget.
+  detail::install_charged_functions(state);
   lua_getfield(state, -1, LUA_MATHLIBNAME);
   lua_getfield(state, -1, "randomseed");
   lua_pushcclosure(state, randomseed_checked, 1);
@@ -252,6 +256,23 @@ void LuaSandbox::count_hook(lua_State* state, lua_Debug* debug) {
   lua_pushfstring(state, "%s:%d: instruction budget of %I instructions exceeded (an endless loop?)",
                   debug->short_src, debug->currentline, static_cast<lua_Integer>(sandbox->budget_));
   lua_error(state);
+}
+
+void LuaSandbox::charge(lua_State* state, long long steps, const char* what) {
+  void* self = nullptr;
+  lua_getallocf(state, &self);
+  auto* sandbox = static_cast<LuaSandbox*>(self);
+  if (steps <= sandbox->budget_ - sandbox->instructions_) {   // no overflow: steps may be 2^63 - 1
+    sandbox->instructions_ += steps;
+    return;
+  }
+  sandbox->instructions_ = sandbox->budget_ + 1;
+  if (!sandbox->hook_every_instruction_) {
+    lua_sethook(state, &LuaSandbox::count_hook, LUA_MASKCOUNT, 1);
+    sandbox->hook_every_instruction_ = true;
+  }
+  luaL_error(state, "instruction budget of %I instructions exceeded in %s", static_cast<lua_Integer>(sandbox->budget_),
+             what);
 }
 
 void LuaSandbox::start_budget(Budget budget) {

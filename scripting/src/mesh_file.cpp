@@ -13,6 +13,10 @@
 #include <cstring>
 #include <map>
 
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
 #include "messages.hpp"
 
 namespace graspsim::scripting::detail {
@@ -22,17 +26,47 @@ namespace {
   throw ConversionError(where + ": " + what);
 }
 
+const char* not_regular(mode_t mode) {
+  if (S_ISDIR(mode)) return "a directory";
+  if (S_ISFIFO(mode)) return "a FIFO";
+  if (S_ISCHR(mode)) return "a character device";
+  if (S_ISBLK(mode)) return "a block device";
+  if (S_ISSOCK(mode)) return "a socket";
+  return "not a regular file";
+}
+
+// The whole file, if it is a regular file of at most kMaxMeshFileBytes. Opened without blocking
+// (a FIFO would wait for a writer) and checked on the open descriptor (the path cannot change
+// between the check and the read); read to at most one byte over the limit, so a file that
+// grows while it is read is refused too.
 std::string read_bytes(const std::string& path) {
-  std::FILE* file = std::fopen(path.c_str(), "rb");
-  if (file == nullptr) fail_at(path, std::string("cannot open mesh file: ") + std::strerror(errno));
+  const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+  if (fd < 0) fail_at(path, std::string("cannot open mesh file: ") + std::strerror(errno));
+  struct Closer {
+    int fd;
+    ~Closer() { ::close(fd); }
+  } closer{fd};
+  struct stat st {};
+  if (::fstat(fd, &st) != 0) fail_at(path, std::string("cannot read mesh file: ") + std::strerror(errno));
+  if (!S_ISREG(st.st_mode)) {
+    fail_at(path, std::string("cannot read mesh file: it is ") + not_regular(st.st_mode) +
+                      ", not a regular file (a mesh is read from a file; reading this could block or never end)");
+  }
+  const auto too_large = [&](const std::string& size) {
+    fail_at(path, "mesh file too large: " + size + " bytes, over the limit of " + std::to_string(kMaxMeshFileBytes) +
+                      " bytes (64 MiB; README \"Mesh files\")");
+  };
+  if (static_cast<std::uint64_t>(st.st_size) > kMaxMeshFileBytes) too_large(std::to_string(st.st_size));
   std::string bytes;
   char buffer[1 << 16];
-  std::size_t n = 0;
-  while ((n = std::fread(buffer, 1, sizeof buffer, file)) > 0) bytes.append(buffer, n);
-  const bool failed = std::ferror(file) != 0;
-  const int error = errno;
-  std::fclose(file);
-  if (failed) fail_at(path, std::string("cannot read mesh file: ") + std::strerror(error));
+  for (;;) {
+    const ssize_t n = ::read(fd, buffer, sizeof buffer);
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0) fail_at(path, std::string("cannot read mesh file: ") + std::strerror(errno));
+    if (n == 0) break;
+    bytes.append(buffer, static_cast<std::size_t>(n));
+    if (bytes.size() > kMaxMeshFileBytes) too_large("more than " + std::to_string(kMaxMeshFileBytes));
+  }
   return bytes;
 }
 

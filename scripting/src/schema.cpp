@@ -692,9 +692,20 @@ ScenarioParts convert_scenario(const LuaValue& root, const std::string& default_
   } catch (const std::invalid_argument& e) {
     throw ConversionError(e.what());
   }
+  // The ceilings (scenario.hpp): refused before a run commits memory or disk to them.
+  const Rates& rates = s.model.rates;
+  if (rates.servo > kMaxServoRate) {
+    throw ConversionError("rates.servo: " + std::to_string(rates.servo) + " Hz is over the ceiling of " +
+                          std::to_string(kMaxServoRate) + " Hz (10 times the fastest haptic servo loop; the trace "
+                          "holds a quarter second of rows per table in memory)");
+  }
+  if (s.duration > kMaxDuration) {
+    fail(r.at("duration"), format_short(s.duration) + " s is over the ceiling of " + format_short(kMaxDuration) +
+                               " s (24 h of simulated time: " + format_short(s.duration * rates.servo) +
+                               " servo ticks at " + std::to_string(rates.servo) + " Hz)");
+  }
   // Every loop runs exactly duration x rate times, so the duration is a whole number of periods
   // of each loop; time is tick / servo, never accumulated, and exact while ticks < 2^53.
-  const Rates& rates = s.model.rates;
   const std::pair<const char*, int> loops[] = {
       {"servo", rates.servo}, {"haptic", rates.haptic}, {"physics", rates.physics}};
   for (const auto& [loop, rate] : loops) {

@@ -1,4 +1,4 @@
-// Devices on the command line (issue 6, items 1, 2, 6, 7): --device specs and their errors, a
+// Devices on the command line (README.md, "Devices"): --device specs and their errors, a
 // finger replayed from another trace, a mapped device session recorded in /devices/<finger> and
 // replayed bit for bit, and every device released (zero force) at the end, on error and on
 // interrupt.
@@ -161,7 +161,7 @@ TEST_CASE("Scenario device fields: errors name the field", "[e2e][devices]") {
 TEST_CASE("A finger run with --device index=replay:TRACE reproduces the recording of that finger's run, bit for bit",
           "[e2e][devices][replay]") {
   // Law: the engine is a deterministic function of its inputs. The index finger fed from its
-  // recorded hip and gimbal (and the thumb scripted as before) gives the same inputs, hence the
+  // recorded hip and gimbal (and the thumb scripted as in the recording) gives the same inputs, hence the
   // same state hash at every physics tick and the same /servo rows, bit for bit (no tolerance).
   const auto scenario = scripting::Scenario::load(kLift);
   app::RunOptions rec;
@@ -364,8 +364,8 @@ TEST_CASE("graspsim run --device: bad specs exit 2 before writing, a replayed fi
 
 TEST_CASE("Every library scenario with its first finger on replay: reproduces its run bit for bit",
           "[e2e][devices][replay][scenarios]") {
-  // The issue's 'done when' for replay: for each scenario in scenarios/, a scripted run, then the
-  // same scenario with its first finger switched to replay:<that run> (the other fingers still
+  // Replay of a device session, library-wide: for each scenario in scenarios/, a scripted run, then
+  // the same scenario with its first finger switched to replay:<that run> (the other fingers still
   // scripted, Lua feedback controllers included) gives the same state hash at every physics tick
   // and the same expectation results (law: determinism in the inputs; no tolerance).
   std::vector<std::string> files;
@@ -432,7 +432,7 @@ TEST_CASE("The force ramp scales rendered forces by t / ramp, leaves the engine 
   CHECK(recordings::compare_traces(ramped.out, kTmp + "/ramp_2s.replay.h5", bitwise).same());
 }
 
-// Every finger on the simulated Phantom (issue 6): the run is recorded with /devices/<finger>
+// Every finger on the simulated Phantom: the run is recorded with /devices/<finger>
 // (the device's own samples) and replays bit for bit. The stylus is held by a 300 N/m hand and
 // the Premium 1.5's force is derated to its continuous 1.4 N: the lift's expectations are the
 // scenario's business (here they fail: too weak a grip for a 0.2 kg box), the replay is ours.
@@ -451,10 +451,10 @@ TEST_CASE("A run with every finger on sim-phantom records its samples and replay
 }
 
 TEST_CASE("A device trace written before the sample counter columns still replays bit for bit", "[e2e][devices][replay]") {
-  // /devices/<finger>/sequence and new_samples arrived in session 4. A session recorded before
-  // has neither (here: the same run with RunOptions::device_counters off, which writes exactly
-  // that table); its replay must write none either, or compare refuses the tables' different
-  // columns and the replay reports 'differs' (as it did before this test).
+  // A device table without /devices/<finger>/sequence and new_samples, as a trace from a build
+  // without the sample counter has it (here: the same run with RunOptions::device_counters off,
+  // which writes exactly that table); its replay must write neither column, or compare refuses
+  // the tables' different columns and the replay reports 'differs'.
   const auto scenario = scripting::Scenario::load(kLift);
   const app::DeviceRegistry registry = app::default_registry();
   const app::DevicePlan plan = app::plan_devices(scenario, {"thumb=sim-phantom"}, registry);

@@ -1,4 +1,4 @@
-// Lua off the real-time thread (issue 6, item 5; tools/app/script_thread.hpp): in a paced run Lua
+// Lua off the real-time thread (tools/app/script_thread.hpp): in a paced run Lua
 // trajectories are sampled ahead on a script thread into rings, expectations are checked after
 // the loop, and the loop's thread may not enter Lua (the sandbox's thread guard). Paced runs use
 // a fake clock (as tests/e2e/test_pacer.cpp): no wall-clock thresholds. A fake clock lets the loop
@@ -313,7 +313,7 @@ TEST_CASE("A request off the servo ticks gets the tick before it and is counted 
   SECTION("the first request between ticks") {
     // A device at its own rate under a servo rate that is no multiple of it (sim-phantom at
     // 1 kHz under 1500 Hz) asks first between ticks: tick 1's sample for 1.5 ticks, never the
-    // zero sample nobody computed (as it got before session 4's review).
+    // zero sample nobody computed.
     CHECK(t->sample(1.5 / 3000).position.x() == 1.0);
     CHECK(script.off_grid() == 1);
   }

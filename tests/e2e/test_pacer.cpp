@@ -1,4 +1,4 @@
-// The real-time pacer (issue 6, item 5) on an injected clock: no wall-clock thresholds. A tick
+// The real-time pacer (tools/app/pacer.hpp) on an injected clock: no wall-clock thresholds. A tick
 // whose work ends after start + (n + 1) T is an overrun, one that ends more than the stall
 // timeout after the previous tick ended is a stall; an early tick sleeps to its deadline exactly. In a run, an
 // artificially slow device read is counted and flagged in /devices, and a stall releases every

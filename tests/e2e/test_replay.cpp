@@ -1,8 +1,8 @@
-// Replay (issue 4, item 7): a trace's scenario rerun with every finger fed from its recorded
-// device samples reproduces the trace bit for bit (the state hash of every physics tick and
-// every dataset, compared with the same code as `graspsim compare --bitwise`); a what-if replay
-// with another mu keeps the hand motion and parts where friction first matters; bad input exits
-// 2 with a message naming the file and what is wrong, writing nothing.
+// Replay (README.md, "Replaying a trace"): a trace's scenario rerun with every finger fed from its
+// recorded device samples reproduces the trace bit for bit (the state hash of every physics tick
+// and every dataset, compared with the same code as `graspsim compare --bitwise`); a what-if replay
+// with another mu keeps the hand motion and parts where friction first matters; bad input exits 2
+// with a message naming the file and what is wrong, writing nothing.
 #include <catch2/catch.hpp>
 #include <hdf5.h>
 

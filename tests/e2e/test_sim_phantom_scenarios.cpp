@@ -1,4 +1,4 @@
-// Library scenarios with every finger on the simulated Phantom (issue 6, "Done when"): the ones
+// Library scenarios with every finger on the simulated Phantom: the ones
 // a Phantom can physically perform meet their expectations; one it cannot fails for the stated
 // reason, the device's continuous (thermal) force limit. hw/README.md, "Simulated Phantom", has
 // the whole table and the reason for every scenario left out.
@@ -84,7 +84,7 @@ struct Outcome {
 };
 
 // `test`: the calling test's own name for its traces, so that tests ctest runs in parallel never
-// write the same file (two of them once both wrote sim_phantom_two_finger_lift.h5 and failed).
+// write the same file (two writing sim_phantom_two_finger_lift.h5 at once fail).
 Outcome run_on_sim_phantom(const std::string& scenario_name, const std::string& spec, const std::string& test) {
   const auto scenario = scripting::Scenario::load(kSource + "/scenarios/" + scenario_name + ".lua");
   const app::DeviceRegistry registry = app::default_registry();

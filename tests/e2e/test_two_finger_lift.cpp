@@ -94,7 +94,7 @@ TEST_CASE("the two-finger lift's trace has every dataset with the right lengths"
 
 // Determinism: the same scenario and seed give the same trace, bit for bit. Two runs in one
 // process must agree on every value of every loop (tolerance zero). Across processes and
-// builds is the traces issue's to test.
+// builds: tests/golden/test_golden.cpp.
 TEST_CASE("the same scenario run twice gives a bit-identical trace", "[e2e][determinism]") {
   const auto scenario = scripting::Scenario::load(kScenario);
   std::vector<std::string> files;

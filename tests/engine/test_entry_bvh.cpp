@@ -15,7 +15,8 @@ using namespace graspsim;
 
 namespace {
 
-// The linear scan the engine used before the tree (engine/src/surface.cpp, surface_entry).
+// The linear scan over every face that the tree must equal bit for bit (engine/src/surface.cpp,
+// surface_entry).
 struct Scan {
   double t = kInfinity;
   int face = -1;

@@ -1,5 +1,5 @@
-// Finger pads of finite radius (issue 3, item 11): a sphere of radius r touching a face is its
-// centre (the HIP) touching the face moved out by r; the force acts on the surface.
+// Finger pads of finite radius (engine/README.md, "Finger pads"): a sphere of radius r touching a
+// face is its centre (the HIP) touching the face moved out by r; the force acts on the surface.
 #include <catch2/catch.hpp>
 
 #include <algorithm>

@@ -1,7 +1,7 @@
-// The gyroscopic term of Euler's equation (issue 3, item 1): the three options of
-// integrate_body (the paper's neglect, explicit, one Newton step of implicit Euler) against
-// Euler's equations for a torque-free asymmetric body, their energy, their order, and their
-// agreement where the gyroscopic term vanishes.
+// The gyroscopic term of Euler's equation (README.md, "Speed against error"): the three options of
+// integrate_body (the paper's neglect, explicit, one Newton step of implicit Euler) against Euler's
+// equations for a torque-free asymmetric body, their energy, their order, and their agreement where
+// the gyroscopic term vanishes.
 #include <catch2/catch.hpp>
 
 #include <algorithm>
@@ -242,7 +242,7 @@ TEST_CASE("energy of a tumbling free body never increases with the implicit gyro
 // which leaves w_b unchanged, so with kImplicit E never increases, for either ordering. Shown for
 // moments 3:2:1 spun near the middle axis at 50 Hz for 10 s (every step: E_{k+1} <= E_k (1 +
 // 1e-12), rounding only); 1:2:3 is the test above. With the paper's increment in place of the
-// exact rotation the same run had gained 4% (26.0 J from 25 J) before this was changed.
+// exact rotation the same run gains 4% (26.0 J from 25 J).
 TEST_CASE("with the implicit term energy never grows for either ordering of the moments",
           "[gyroscopic][law]") {
   const Vec3 inertia321{3.0, 2.0, 1.0};   // kg m^2
@@ -362,9 +362,9 @@ TEST_CASE("a torque about a principal axis gives w_dot = T / J for every option"
   }
 }
 
-// Regression guard. (1) The paper's form is unchanged: from a general state (rotated, moving,
-// spinning) with a general force and torque, kNeglect gives the same bits as the paper's
-// formulas written out here in the same operations and order:
+// The paper's form, bit for bit. (1) From a general state (rotated, moving, spinning) with a
+// general force and torque, kNeglect gives the same bits as the paper's formulas written out here
+// in the same operations and order:
 //   a = F / m, v += a dt, p += v dt, w += R (Jp^-1 (R^T T)) dt, R = (I + S(w) dt) R,
 //   then a = a/|a|, n = o x a, n = n/|n|, o = a x n.
 // (2) On a body with w = 0 the gyroscopic term is exactly zero, so all three options give

@@ -1,8 +1,8 @@
-// Hard cases (issue 5, item 2): scenes at the edge of a law or of the explicit integration's
-// stability. Each test names its law, derives the value it checks, and sweeps the parameter that
-// decides it. The issue's other hard cases (spin flip, gyroscopic precession, corner drop) are not
-// here; the dead band's own laws are in test_dead_band.cpp. Each case here has a scenario
-// (scenarios/dead_band.lua, heavy_hold, stack_mass_ratio, plate_push, incline_threshold,
+// Hard cases (engine/README.md, "Hard cases"): scenes at the edge of a law or of the explicit
+// integration's stability. Each test names its law, derives the value it checks, and sweeps the
+// parameter that decides it. The benchmark's hard cases (spin flip, gyroscopic precession, corner
+// drop) are in tests/bench; the dead band's own laws are in test_dead_band.cpp. Each case here has
+// a scenario (scenarios/dead_band.lua, heavy_hold, stack_mass_ratio, plate_push, incline_threshold,
 // rod_swing_fast).
 #include <catch2/catch.hpp>
 

@@ -1,5 +1,5 @@
-// Static and kinetic friction, and viscous friction while slipping (issue 3, item 8): the
-// friction circle's radius is mu_s depth while sticking and mu_k depth + c v / k while slipping.
+// Static and kinetic friction, and viscous friction while slipping (engine/README.md): the friction
+// circle's radius is mu_s depth while sticking and mu_k depth + c v / k while slipping.
 #include <catch2/catch.hpp>
 
 #include <algorithm>

@@ -253,3 +253,48 @@ TEST_CASE("a scenario's outcome with sleep equals the one without it", "[sleep][
     CHECK((end[1].position - end[0].position).norm() < 1e-4);   // measured 1.3e-6 m
   }
 }
+
+// A sleeper wakes when its support goes, even when nothing that moves is fast enough to wake
+// it: a 2 cm box asleep on a 4 cm box, the lower one pushed out from under it by a finger at
+// 2 cm/s (below this scene's 5 cm/s sleep threshold, so its motion alone wakes nothing). The
+// pair loses its last contact point when the lower box has moved 3 cm (half widths 2 + 1 cm);
+// the upper box wakes at that physics step and falls 4 cm onto the floor, resting with its
+// centre at its half width (implicit default contact: sinks micrometres; 1 mm allowed for the
+// landing's tilt). Left asleep, it would hang in the air at 5 cm for ever.
+TEST_CASE("a sleeping body wakes when its support goes from under it", "[sleep][law]") {
+  Model m;
+  m.integrator = Integrator::kImplicit;
+  m.rates = Rates{3000, 500, 50};
+  m.sleep.enabled = true;
+  m.sleep.time = 0.2;
+  m.sleep.linear_speed = 0.05;
+  m.floor.enabled = true;
+  m.floor.material = Material{0.3, kInfinity, kInfinity};
+  m.bodies.push_back(graspsim::test::make_box("lower", 0.2, Vec3::Constant(0.02), Vec3(0.0, 0.0, 0.02),
+                                              Material{0.3, kInfinity, kInfinity}));
+  m.bodies.push_back(graspsim::test::make_box("upper", 0.05, Vec3::Constant(0.01), Vec3(0.0, 0.0, 0.05),
+                                              Material{0.3, kInfinity, kInfinity}));
+  m.fingers.push_back(graspsim::test::make_finger("index", 400.0, 2.0));
+  Simulation sim(m);
+  Input input = make_input(m);
+  TickRecord record = make_tick_record(m);
+  bool both_asleep = false;
+  std::int64_t lost = -1, woke = -1;
+  for (int n = 0; n < 3000 * 4; ++n) {
+    // From 3 cm at -x towards the lower box's face (at -2 cm) from t = 0.6 s at 2 cm/s, 1 cm up.
+    const double t = sim.time();
+    input.fingers[0].hip = Vec3(-0.03 + 0.02 * std::max(0.0, t - 0.6), 0.0, 0.01);
+    const bool was_asleep = sim.state().bodies[1].asleep;
+    const bool had_contact = sim.state().pairs[0].count > 0;
+    sim.step(input, record);
+    if (!record.physics_ran) continue;
+    if (t < 0.6 && sim.state().bodies[0].asleep && sim.state().bodies[1].asleep) both_asleep = true;
+    if (had_contact && sim.state().pairs[0].count == 0 && lost < 0) lost = record.tick;
+    if (was_asleep && !sim.state().bodies[1].asleep && woke < 0) woke = record.tick;
+  }
+  REQUIRE(both_asleep);
+  REQUIRE(lost > 0);
+  CHECK(woke == lost);
+  CHECK(sim.state().bodies[0].position.x() > 0.03);
+  CHECK(sim.state().bodies[1].position.z() == Approx(0.01).margin(1e-3));
+}

@@ -15,7 +15,7 @@ using namespace graspsim::test;
 namespace {
 
 // The contact set a scenario reaches at `seconds` with physics at 100 Hz (stable for all four
-// grasps below) and finger `finger` moved by `offset`, as the issue's runs move one waypoint.
+// grasps below) and finger `finger` moved by `offset`, as a hand placed off by `offset` would be.
 struct Reached {
   scripting::Scenario scenario;
   State state;
@@ -32,23 +32,24 @@ Reached reach(const std::string& name, double seconds, int finger, const Vec3& o
 
 }  // namespace
 
-// The issue's four grasps, each with the contact set it reaches (run at 100 Hz, one finger
-// 0.1 mm off as in the issue), analysed under the paper's scheme at 50 Hz and at 100 Hz. The
-// figures the issue measured by hand, derived here where a single mode gives them:
+// Four library grasps, each with the contact set it reaches (run at 100 Hz, one finger 0.1 mm
+// off), analysed under the paper's scheme at 50 Hz and at 100 Hz. The figures measured by hand
+// on the runs (engine/README.md, "Stability check"), derived here where a single mode gives them:
 //  - gravity_drop's rod (0.2 kg, 20 x 4 x 4 cm) pinched 8 cm off centre by two 400 N/m pads:
-//    sideways motion with yaw and roll on the two springs, radius 3.89 at 50 Hz (issue: 3.89);
+//    sideways motion with yaw and roll on the two springs, radius 3.89 at 50 Hz (by hand: 3.89);
 //  - two_finger_lift's box squeezed on its floor (pads 400 N/m at +-4 cm, 100 N/m corners):
-//    pitch about y on finger and floor springs together, each stable alone, 2.0 (issue: 2.0);
+//    pitch about y on finger and floor springs together, each stable alone, 2.0 (by hand: 2.0);
 //  - gimbal_twist's 6 cm, 0.2 kg box on two 400 N/m, 4 N s/m pads at +-3 cm: its pitch alone
 //    has K = 2 k a^2 = 0.72 N m/rad, C = 2 c a^2, I = 2 m a^2 / 3, so h^2 K / I = 2.4 and
-//    h C / I = 1.2: radius 1.717 (the issue's 1.72). The pads hold it 2.9 mm above its centre
+//    h C / I = 1.2: radius 1.717 (by hand: 1.72). The pads hold it 2.9 mm above its centre
 //    (the hanging sag), which couples pitch with sideways translation and stiffens the mode: the
 //    coupled map's radius is a little larger (1.83);
 //  - three_finger_rotate's cube closed on by three fingers on its floor: pitch about y on the
-//    fingers and the floor, 1.57. (The issue's 2.64 for "a box held by three fingers" is not a
-//    library scene; this cube once lifted has radius 0.99, and is not flagged.)
-// Tolerance 0.5% on the issue's figures: they were quoted to three digits.
-TEST_CASE("the issue's four grasps are flagged at 50 Hz and not at 100 Hz", "[stability][scenario]") {
+//    fingers and the floor, 1.57. (A figure of 2.64 measured by hand for "a box held by three
+//    fingers" is not of a library scene; this cube once lifted has radius 0.99, and is not
+//    flagged.)
+// Tolerance 0.5% on the figures measured by hand: they are quoted to three digits.
+TEST_CASE("four library grasps are flagged at 50 Hz and not at 100 Hz", "[stability][scenario]") {
   struct Case {
     std::string scenario;
     double seconds;   // s: when the grasp has formed

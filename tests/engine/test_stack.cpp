@@ -142,9 +142,9 @@ TEST_CASE("a 100:1 stack rests at 3000 Hz and is flagged at 50 Hz", "[stack][law
 // 4 k d a along x (d a / s = 0.25% of F_t); the anchors are material points d / 2 inside A, so
 // turning A by 4.5 mrad about its bottom face moves them by (d / 2) 4.5 mrad = 1.1% of s; the
 // corners move by x (1 - cos a) <= 5e-7 m, 0.25% of s. Within 1.6% (1.1% measured), 2% checked.
-// The keys used to name the clip points by the reference face and its side planes, so every
-// change of reference dropped all four anchors and the stretch with them (F_t = 0): a box rocking
-// on a base walked off it a stretch at a time.
+// Keys that named the clip points by the reference face and its side planes would drop all four
+// anchors and the stretch with them (F_t = 0) at every change of reference: a box rocking on a
+// base would walk off it a stretch at a time.
 TEST_CASE("a box's friction stretch on a box survives a change of reference face", "[stack][manifold][law]") {
   const double k = 500.0, d = 0.001, s = 0.0002;
   Model m;

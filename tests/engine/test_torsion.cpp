@@ -183,8 +183,8 @@ TEST_CASE("the dead band zeroes torques up to T_crit and leaves larger ones", "[
 // end by the floor: the scaled gravity torque about the axis (m g d / 2 = 0.078 N m) is balanced
 // by the floor's, which needs its far springs (2 x 100 N/m, 0.1 m from the axis) compressed by
 // ~4 mm: a tilt of ~0.04 rad, 0.06 with the first overshoot. So the tilt stays below 0.1 rad
-// (it was 0.46 rad, and the box tore out of the grasp, when the floor's torque about the axis
-// was dropped), the box comes to rest, and the fingers keep it.
+// (it is 0.46 rad, and the box tears out of the grasp, if the floor's torque about the axis is
+// dropped), the box comes to rest, and the fingers keep it.
 TEST_CASE("a pinched box resting on the floor is not turned through it by the gravity drop",
           "[torsion][law]") {
   Model m;
@@ -216,8 +216,8 @@ TEST_CASE("a pinched box resting on the floor is not turned through it by the gr
 // Above A_crit the lock holds about any axis, not only a principal one. Fingers pinching the rod
 // at different heights (z = -+1 cm) make the axis skewed in the y-z plane; the rod, without
 // gravity, is set spinning about a general direction, so the finger springs' torques have
-// components that would turn it about u through the off-diagonal inertia (0.26 rad/s leaked
-// before the rate was protected). The rate about u must stay zero: below 1e-6 rad/s, since the
+// components that would turn it about u through the off-diagonal inertia (0.26 rad/s leaks
+// when the rate is not protected). The rate about u must stay zero: below 1e-6 rad/s, since the
 // check takes u after the step and the rule before it (measured 1.5e-9). At 500 Hz: at 50 Hz this
 // spinning rod's rotation against the finger springs 8 cm away (K/I ~ 7400 s^-2, (w h)^2 ~ 3)
 // is at the explicit stability bound and tears out of the grasp.

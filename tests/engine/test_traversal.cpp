@@ -1,5 +1,6 @@
-// Polygon boundary traversal (issue 3, item 7): the god-object walk over convex polyhedra and
-// triangle meshes (surface.hpp), and finger contact on every shape kind in a Simulation.
+// Polygon boundary traversal (engine/README.md, "Choices, and why"): the god-object walk over
+// convex polyhedra and triangle meshes (surface.hpp), and finger contact on every shape kind in a
+// Simulation.
 #include <catch2/catch.hpp>
 
 #include <algorithm>
@@ -329,13 +330,13 @@ TEST_CASE("a degenerate triangle in a mesh is ignored", "[traversal][surface]") 
 
 // A body moving onto a resting finger (the finger's HIP never moves; a box, the same cube as a
 // closed mesh, and as a convex hull, 6 cm, flying at -1 m/s along x in zero gravity, its path
-// passing 2 cm off centre in y). The finger's path since its last haptic tick is taken relative
-// to the body: from the body's frame before the physics step to its frame after it. The finger
+// passing 2 cm off centre in y). The finger's path since its last haptic tick is taken relative to
+// the body: from the body's frame before the physics step to its frame after it. The finger
 // therefore enters through the -x face, the face the body's motion brought to it, whatever the
-// depth of the first haptic tick inside (up to one physics step of motion, 2 cm at 50 Hz). Taken
-// in the current frame alone the path is a point: the mesh and hull would enter nothing (the
-// ring of handle_lift fell through its finger) and the box would take its nearest face, +y at
-// 1 cm rather than -x at up to 2 cm.
+// depth of the first haptic tick inside (up to one physics step of motion, 2 cm at 50 Hz). Taken in
+// the current frame alone the path is a point: the mesh and hull would enter nothing (the ring of
+// handle_lift would fall through its finger) and the box would take its nearest face, +y at 1 cm
+// rather than -x at up to 2 cm.
 TEST_CASE("a body moving onto a resting finger is entered through the face that met it", "[finger_contact][law]") {
   const Vec3 h(0.03, 0.03, 0.03);
   const TriangleMesh cube = graspsim::test::box_mesh(h);

@@ -276,7 +276,7 @@ TEST_CASE("device_model: the table holds the four models and an unknown name lis
   CHECK(device_models().size() == 4);
   const DeviceModel& premium = device_model("premium-1.5");
   CHECK(&device_model("Phantom Premium 1.5") == &premium);
-  // The issue's figures for the Premium 1.5.
+  // The Premium 1.5's figures (hw/README.md, "Device models").
   CHECK(premium.peak_force == 8.5);
   CHECK(premium.continuous_force == 1.4);
   CHECK(premium.tip_mass == 0.075);
@@ -298,5 +298,32 @@ TEST_CASE("device_model: the table holds the four models and an unknown name lis
     CHECK_THAT(what, Catch::Contains("\"phantom\""));
     for (const char* key : {"premium-1.5", "premium-1.5-hf", "omni", "touch"})
       CHECK_THAT(what, Catch::Contains(key));
+  }
+}
+
+// The stall rule's exact boundary: the force is held while time - last request <= stall_timeout,
+// and zero once it is more (force_safety.hpp). Times chosen exact in binary (request at 0.5 s,
+// timeout 0.25 s): at 0.75 s the force is still held; at the next double above 0.75 s it is zero,
+// and limit() agrees. A rule that stalled at the timeout itself (>=) fails the first check, one
+// that waited a tick more the second.
+TEST_CASE("ForceSafety: the stall boundary is exact: held at the timeout, zero just past it",
+          "[hw][force_safety][law]") {
+  ForceSafetyConfig c;
+  c.rise_time = 0.0;
+  c.stall_timeout = 0.25;
+  const Vec3 f(0.5, 0.0, 0.0);   // N: below every limit
+  {
+    ForceSafety safety(c);
+    safety.request(f, 0.5);
+    CHECK(safety.limit(0.75) > 0.0);
+    CHECK(safety.output(0.75) == f);
+  }
+  {
+    ForceSafety safety(c);
+    safety.request(f, 0.5);
+    const double past = std::nextafter(0.75, 1.0);
+    CHECK(safety.limit(past) == 0.0);
+    CHECK(safety.output(past).norm() == 0.0);
+    CHECK_FALSE(safety.active());
   }
 }

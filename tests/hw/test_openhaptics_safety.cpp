@@ -1,8 +1,8 @@
-// The OpenHaptics backend as a real device (issue 6, items 6 and 7), against the HD API test
-// double: its clock (servo frames at HD_UPDATE_RATE) and frame numbers for the trace, and the
-// force safety its servo callback applies (nominal peak and continuous force, ramp, stall,
-// release). The double runs one servo frame per run_frames(1) on this thread: the device's time
-// is its frame count, injected, never a wall clock.
+// The OpenHaptics backend as a real device (hw/README.md, "Connecting Phantoms"), against the HD
+// API test double: its clock (servo frames at HD_UPDATE_RATE) and frame numbers for the trace, and
+// the force safety its servo callback applies (nominal peak and continuous force, ramp, stall,
+// release). The double runs one servo frame per run_frames(1) on this thread: the device's time is
+// its frame count, injected, never a wall clock.
 #include <catch2/catch.hpp>
 
 #include <algorithm>
@@ -142,9 +142,9 @@ TEST_CASE("OpenHaptics: committed forces follow the peak ramp and thermal contin
 
 // Release, and the servo's own stall, re-arm the ramp: a 0.5 N push (under C, so only the ramp
 // limits it) rises as P (k - k0) / (rate T_rise) from the frame k0 that took the request, is
-// committed whole once the ramp passes it, is zero from the frame after release(), and rises
-// from zero again from the first request after it; the same after a stall (no request for
-// kOpenHapticsStallFrames frames), where it used to come back at full force at once.
+// committed whole once the ramp passes it, is zero from the frame after release(), and rises from
+// zero again from the first request after it; the same after a stall (no request for
+// kOpenHapticsStallFrames frames), where without the ramp it would come back at full force at once.
 TEST_CASE("OpenHaptics: after a release or a stall forces ramp in again", "[hw][openhaptics][safety]") {
   Fresh fresh;
   auto& fake = hd_double::add_device("P");   // 8.5 N peak, 1.4 N continuous, 1 kHz

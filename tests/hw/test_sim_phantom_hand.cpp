@@ -268,7 +268,7 @@ double wall_mode_radius(const Eigen::Matrix4d& map) {
 
 }  // namespace
 
-// The sampled-wall bound with the correction. The hand's impedance is now
+// The sampled-wall bound with the correction. With it the hand's impedance is
 // Z(s) = b_h + k_h / s + k_h / (tau_c s^2); at s = i w its real part is b_h - k_h / (tau_c w^2):
 // the correction is a negative damping, small at the wall's frequency w^2 = (K + k_h) / m. The
 // bound K (T - h) / 2 = b + b_h (the impedance hand's, with the integrator's shift) becomes

@@ -1,4 +1,4 @@
-// UdpDevice as a real device (issue 6, items 6 and 7): its own clock and sample numbering for
+// UdpDevice as a real device (hw/README.md, "UDP protocol"): its own clock and sample numbering for
 // the trace (hw::SampleClock, hw::SampleCounter), and the device's force limits (peak, thermal
 // continuous limit, ramp, release) applied to what it sends (hw/README.md "Force safety").
 // Every case runs on loopback against the in-process peer in lockstep, with graspsim's time

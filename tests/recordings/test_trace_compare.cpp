@@ -154,7 +154,7 @@ TEST_CASE("identical traces compare equal, bitwise and by value", "[compare]") {
   }
 }
 
-// The acceptance case of the issue: one element changed by 1e-9 is found at its tick, time,
+// The acceptance case of compare: one element changed by 1e-9 is found at its tick, time,
 // dataset, object and component.
 TEST_CASE("a 1e-9 change is found at its tick, time, object and component", "[compare]") {
   const auto [a, b] = twins("one_change");

@@ -393,3 +393,46 @@ TEST_CASE("the recorder refuses unusable names and mismatched records", "[trace_
   CHECK_THROWS_AS(recorder.record(rec, rendered, input, state), std::invalid_argument);
   writer.close("complete");
 }
+
+// row_sizes, which the run's memory and disk estimate uses (tools/app/run_budget.cpp), is the
+// rows the constructor declares: for 1 to 3 fingers and 0 to 3 bodies, each table's doubles per
+// row equal TraceTable::row_width() and its bytes per row the stored compound type's size.
+TEST_CASE("row_sizes counts the doubles and bytes of every row the recorder declares", "[trace_recorder]") {
+  for (std::size_t fingers = 1; fingers <= 3; ++fingers) {
+    for (std::size_t bodies = 0; bodies <= 3; ++bodies) {
+      Model m;
+      m.rates = Rates{60, 12, 6};
+      const char* finger_names[] = {"thumb", "index", "middle"};
+      const char* body_names[] = {"box", "rod", "ring"};
+      for (std::size_t f = 0; f < fingers; ++f) m.fingers.push_back(FingerParams{finger_names[f], 500.0});
+      for (std::size_t b = 0; b < bodies; ++b) {
+        BodyParams body;
+        body.name = body_names[b];
+        m.bodies.push_back(body);
+      }
+      INFO(fingers << " fingers, " << bodies << " bodies");
+      const std::string file = tmp_path("row_sizes.h5");
+      const TraceRecorder::Rows rows = TraceRecorder::row_sizes(m);
+      {
+        TraceWriter writer(file);
+        TraceRecorder recorder(writer, m);
+        CHECK(writer.table("servo").row_width() == rows.servo.values);
+        CHECK(writer.table("haptic").row_width() == rows.haptic.values);
+        CHECK(writer.table("physics").row_width() == rows.physics.values);
+        writer.close("complete");
+      }
+      const hid_t f = H5Fopen(file.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+      REQUIRE(f >= 0);
+      for (const auto& [table, size] : {std::pair{"/servo", rows.servo}, std::pair{"/haptic", rows.haptic},
+                                        std::pair{"/physics", rows.physics}}) {
+        const hid_t d = H5Dopen2(f, table, H5P_DEFAULT);
+        const hid_t type = H5Dget_type(d);
+        INFO(table);
+        CHECK(H5Tget_size(type) == size.bytes);
+        H5Tclose(type);
+        H5Dclose(d);
+      }
+      H5Fclose(f);
+    }
+  }
+}

@@ -753,7 +753,7 @@ TEST_CASE("a table too wide for one HDF5 row type fails at the first row", "[tra
 
 // No object of a trace carries a time stamp, the root group included, so two runs of the same
 // inputs write the same bytes whatever second they ran in (with them, the root group's header
-// differed, and this file's background-vs-inline byte test failed about once in 40 runs).
+// differs, and this file's background-vs-inline byte test fails about once in 40 runs).
 TEST_CASE("no object of a trace carries a time stamp", "[trace_writer]") {
   const std::string file = tmp_path("untimed.h5");
   {

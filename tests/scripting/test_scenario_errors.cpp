@@ -188,3 +188,20 @@ TEST_CASE("bad sleep values are named with their field", "[scenario][errors]") {
   CHECK_THAT(message({"sleep.linear_speed=-1"}), Catch::Contains("sleep.linear_speed"));
   CHECK_THAT(message({"sleep=3"}), Catch::Contains("sleep") && Catch::Contains("expected a table, true or false"));
 }
+
+// The ceilings on a run's size (scenario.hpp, scripting/README.md "Ceilings"): rates.servo up to
+// 100 kHz and duration up to 86,400 s load, one step over is refused naming the field and the
+// ceiling (figures that would exhaust a machine: --duration 1e12, rates of 1e7 and 1e9 Hz). Loads
+// only: nothing runs.
+TEST_CASE("rates.servo and duration have ceilings: at the ceiling a scenario loads, one step over it is "
+          "refused naming the figure", "[scenario][errors][ceiling]") {
+  CHECK(message({"rates.servo=100000", "rates.haptic=100000", "rates.physics=100000"}) == "no error");
+  CHECK_THAT(message({"rates.servo=100001", "rates.haptic=100001", "rates.physics=100001"}),
+             Contains("rates.servo: 100001 Hz is over the ceiling of 100000 Hz"));
+  for (const char* rate : {"10000000", "1000000000"}) {
+    CHECK_THAT(message({std::string("rates.servo=") + rate}), Contains(std::string("rates.servo: ") + rate + " Hz is over the ceiling"));
+  }
+  CHECK(message({"duration=86400"}) == "no error");
+  CHECK_THAT(message({"duration=86400.01"}), Contains("duration: 86400.01 s is over the ceiling of 86400 s"));
+  CHECK_THAT(message({"duration=1e12"}), Contains("duration: 1e+12 s is over the ceiling of 86400 s (24 h of simulated time: 3e+15 servo ticks at 3000 Hz)"));
+}

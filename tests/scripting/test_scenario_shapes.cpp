@@ -9,11 +9,14 @@
 #include <string>
 #include <vector>
 
+#include <sys/stat.h>
+
 #include <catch2/catch.hpp>
 
 #include "graspsim/engine/record.hpp"
 #include "graspsim/engine/simulation.hpp"
 #include "graspsim/scripting/scenario.hpp"
+#include "mesh_file.hpp"
 #include "scenario_files.hpp"
 
 using Catch::Matchers::Contains;
@@ -96,7 +99,7 @@ std::string ascii_stl(const std::vector<std::array<Vec3, 3>>& triangles) {
 
 TEST_CASE("every shape loads with its mass properties from density or mass", "[scripting][shape]") {
   const Scenario s = Scenario::load(data_path("shapes.lua"));
-  // box: m = rho x y z, box_inertia (unchanged from before shapes).
+  // box: m = rho x y z, box_inertia.
   CHECK(body(s, "box").shape.kind == ShapeKind::kBox);
   CHECK(body(s, "box").mass == 500.0 * 0.02 * 0.04 * 0.06);
   // sphere: m = rho 4/3 pi r^3, J = 2/5 m r^2.
@@ -273,6 +276,41 @@ TEST_CASE("mesh file errors name the file and line (OBJ, ASCII STL) or triangle 
   tris[4][1].x() = std::nan("");
   CHECK_THAT(error("nan.stl", binary_stl(tris, "binary")), Contains(at + "nan.stl: triangle 5: vertex 2 is not finite"));
   CHECK_THAT(error("cube.ply", "ply\n"), Contains(at + "cube.ply: unknown mesh file type '.ply' (use .obj or .stl)"));
+}
+
+// A mesh is read from a regular file of at most kMaxMeshFileBytes (64 MiB): a link to /dev/zero
+// (which reads without end), a FIFO (which blocks until a writer comes, for ever), a directory and
+// a larger file are refused at once, naming the file and why; a file of exactly the limit is read
+// (and refused for what it holds). The big files are sparse: no disk is used.
+TEST_CASE("a mesh file must be a regular file of at most 64 MiB: a device, a FIFO, a directory or a "
+          "larger file is refused at once", "[scripting][shape][mesh_file][errors]") {
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::path(write_file("cube.obj", kCubeObj)).parent_path();
+  const auto error = [&](const std::string& file) {
+    return load_error(one_object("input_" + file + ".lua", "shape = 'mesh', file = '" + file + "', mass = 1"));
+  };
+  const std::string at = "objects[1] 'm': file: " + dir.string() + "/";
+  std::error_code ec;
+  fs::remove(dir / "zero.stl", ec);
+  fs::create_symlink("/dev/zero", dir / "zero.stl");
+  CHECK_THAT(error("zero.stl"), Contains(at + "zero.stl: cannot read mesh file: it is a character device, not a regular file"));
+  fs::remove(dir / "pipe.obj", ec);
+  REQUIRE(::mkfifo((dir / "pipe.obj").c_str(), 0600) == 0);
+  CHECK_THAT(error("pipe.obj"), Contains(at + "pipe.obj: cannot read mesh file: it is a FIFO, not a regular file"));
+  fs::create_directories(dir / "folder.stl");
+  CHECK_THAT(error("folder.stl"), Contains(at + "folder.stl: cannot read mesh file: it is a directory, not a regular file"));
+  const auto sparse = [&](const std::string& name, std::uintmax_t bytes) {
+    write_file(name, "");
+    fs::resize_file(dir / name, bytes);
+  };
+  const std::uint64_t limit = graspsim::scripting::detail::kMaxMeshFileBytes;
+  REQUIRE(limit == 64ull << 20);
+  sparse("over.stl", limit + 1);
+  CHECK_THAT(error("over.stl"), Contains(at + "over.stl: mesh file too large: 67108865 bytes, over the limit of 67108864 bytes"));
+  sparse("limit.stl", limit);   // read, and refused for its zeros: not an STL
+  CHECK_THAT(error("limit.stl"), Contains(at + "limit.stl: not an STL file"));
+  fs::remove(dir / "over.stl");
+  fs::remove(dir / "limit.stl");
 }
 
 TEST_CASE("shape fields are checked per kind, naming the field", "[scripting][shape][errors]") {

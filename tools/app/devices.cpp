@@ -115,7 +115,7 @@ DeviceRegistry default_registry() {
   r.add({"sim-phantom", "sim-phantom[:MODEL]", false, true, make_sim_phantom_device});
   // In lockstep the peer (a device server replaying or simulating a hand) answers every datagram
   // and waits for us: nobody's hand is on it in real time, so the run is not paced, and a slow
-  // moment of the machine cannot stop it (it did, with a 20 ms stall on a shared VM).
+  // moment of the machine cannot stop it (a 20 ms stall on a shared VM would).
   r.add({"udp", "udp:HOST:PORT", true, true, make_udp,
          [](const std::string& arg) { return hw::parse_udp_spec(arg).lockstep; }, false});
   r.add({"phantom", "phantom:NAME", true, true, make_phantom, {}, false});

@@ -72,8 +72,8 @@ class DeviceRegistry {
   std::vector<DeviceKind> kinds_;   // registration order (messages list them so)
 };
 
-// scripted, replay:TRACE.h5 (built here), and sim-phantom[:MODEL], udp:HOST:PORT, phantom:NAME
-// registered without a factory ("not built into this binary") until their backends are wired in.
+// scripted, replay:TRACE.h5, sim-phantom[:MODEL], udp:HOST:PORT and phantom:NAME, each with its
+// factory (phantom's, in a binary built without the OpenHaptics SDK, throws naming the SDK).
 DeviceRegistry default_registry();
 
 // Parses KIND[:ARG]; throws DeviceError naming `where` for an empty spec, an unknown kind (listing

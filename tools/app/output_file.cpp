@@ -59,8 +59,15 @@ void refuse_input_as_output(const std::string& out, const std::vector<InputFile>
 }
 
 bool locked_by_a_run(const std::string& path) {
-  const int fd = open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  // Non-blocking, and regular files only: opening a FIFO to read waits for a writer for ever
+  // (the trace readers then refuse what is not a regular file, naming what it is).
+  const int fd = open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK);
   if (fd < 0) return false;
+  struct stat st{};
+  if (fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
+    ::close(fd);
+    return false;
+  }
   struct flock lock{};
   lock.l_type = F_WRLCK;
   lock.l_whence = SEEK_SET;

@@ -1,4 +1,4 @@
-// Real-time pacing of the lockstep loop (issue 6, item 5): with a real device attached, servo
+// Real-time pacing of the lockstep loop (README.md, "Devices"): with a real device attached, servo
 // tick n must finish by start + (n + 1) / rate on a monotonic clock. The pacer sleeps until that
 // deadline, counts the ticks that miss it (overruns), and reports a stall (a tick whose forces
 // went out more than `stall_timeout` after the previous tick's) so that the run loop releases
@@ -58,9 +58,9 @@ class Pacer {
   //
   // Two limits, either of which releases every device: a stall (the gap between two ticks'
   // ends past `stall_timeout`: a device holding a stale force) and a lag (a tick ending more than
-  // `lag_limit` past its deadline: a loop steadily too slow for its rate). Until session 4 a
-  // lateness past the 20 ms stall timeout was the only rule: hiccups on a shared VM, each a few
-  // ms and each made up, then stopped runs whose longest gap was a few ms.
+  // `lag_limit` past its deadline: a loop steadily too slow for its rate). Lateness is not held
+  // to the 20 ms stall timeout: on a shared VM hiccups of a few ms, each made up, add up past it,
+  // and would stop runs whose longest gap is a few ms.
   Pacer(MonotonicClock& clock, int rate, double stall_timeout, double lag_limit = kLagLimit);
   void start();                        // tick 0's period begins now
   // After tick n's work: returns how it kept its deadline start + (n + 1) / rate, and sleeps

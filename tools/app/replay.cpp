@@ -18,6 +18,16 @@
 namespace graspsim::app {
 namespace {
 
+// "no such file" or, for a path that is there but is no regular file (a FIFO, a device such as
+// /dev/zero, a directory), what it is: the reader refuses those before HDF5 reads a byte.
+void require_regular_file(const std::string& trace) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  const fs::file_status status = fs::status(trace, ec);
+  if (ec || !fs::exists(status)) throw ReplayError(trace + ": no such file");
+  if (!fs::is_regular_file(status)) throw ReplayError(trace + ": not a regular file (a trace is a file)");
+}
+
 std::vector<std::string> split_lines(const std::string& text) {
   std::vector<std::string> lines;
   std::istringstream in(text);
@@ -113,7 +123,8 @@ RecordedDeviceRows read_device_rows(const std::string& trace, const std::string&
   const recordings::Dataset overrun = recordings::read_dataset(trace, table + "/overrun");
   const recordings::Dataset ticks = recordings::read_dataset(trace, table + "/tick");
   const std::size_t n = r.position.size();
-  if (r.gimbal.size() != n || buttons.values.size() != n || time.values.size() != n || overrun.values.size() != n)
+  if (r.gimbal.size() != n || buttons.values.size() != n || time.values.size() != n || overrun.values.size() != n ||
+      ticks.values.size() != n)
     throw ReplayError(trace + ": " + table + ": columns of different lengths");
   for (std::size_t i = 0; i < n; ++i) {
     if (ticks.values[i] != static_cast<double>(i))
@@ -151,8 +162,7 @@ ReplayPlan load(const std::string& trace, const ReplayOptions& options) {
   namespace fs = std::filesystem;
   ReplayPlan plan;
   plan.trace = trace;
-  std::error_code ec;
-  if (!fs::is_regular_file(trace, ec)) throw ReplayError(trace + ": no such file");
+  require_regular_file(trace);
   if (!recordings::has_attribute(trace, "/", "schema_version")) {
     throw ReplayError(trace + ": not a graspsim trace (no root attribute 'schema_version')");
   }
@@ -168,15 +178,15 @@ ReplayPlan load(const std::string& trace, const ReplayOptions& options) {
                       std::to_string(recordings::kSchemaVersion) + ")");
   }
   plan.status = required_string(trace, "status");
-  // The run's force ramp (0 in traces from before it was recorded): rendered forces again.
+  // The run's force ramp (absent: 0, no ramp): rendered forces again.
   if (recordings::has_attribute(trace, "/", "force_ramp"))
     plan.force_ramp = recordings::read_double_attribute(trace, "/", "force_ramp");
   plan.scenario_path = required_string(trace, "scenario_path");
   plan.scenario_source_hash = required_string(trace, "scenario_source_hash");
   const std::string source = required_string(trace, "scenario_source");
   plan.overrides = split_lines(required_string(trace, "overrides"));
-  // A trace without `integrator` comes from before the implicit step, when every run used the
-  // paper's: it replays with it (first, so that a --set integrator= still wins).
+  // A trace without `integrator` used the paper's step (every run that could use another
+  // records it): it replays with it (first, so that a --set integrator= still wins).
   if (!recordings::has_attribute(trace, "/", "integrator")) plan.overrides.insert(plan.overrides.begin(), "integrator=paper");
   plan.overrides.insert(plan.overrides.end(), options.sets.begin(), options.sets.end());
   plan.what_if = !options.sets.empty();
@@ -289,8 +299,7 @@ ReplayPlan load(const std::string& trace, const ReplayOptions& options) {
 
 RecordedFinger read_recorded_finger(const std::string& trace, const std::string& finger, int rate_servo) {
   try {
-    std::error_code ec;
-    if (!std::filesystem::is_regular_file(trace, ec)) throw ReplayError(trace + ": no such file");
+    require_regular_file(trace);
     if (!recordings::has_attribute(trace, "/", "schema_version"))
       throw ReplayError(trace + ": not a graspsim trace (no root attribute 'schema_version')");
     const std::int64_t schema = recordings::read_int_attribute(trace, "/", "schema_version");
@@ -332,7 +341,7 @@ RunOptions ReplayPlan::run_options(const std::string& out) const {
   options.attributes.emplace_back("replay_of", replay_of());
   for (const RecordedFinger& r : fingers) {
     options.record_devices.push_back(r.device.has_value());
-    // A trace from before the counter columns: the replay writes none either, so that it can
+    // A device table without the counter columns: the replay writes none either, so that it can
     // equal the recording (compare refuses tables whose columns differ).
     if (r.device && !r.device->counted) options.device_counters = false;
   }

@@ -43,7 +43,7 @@ struct RecordedDeviceRows {
   std::vector<double> device_time;       // s, the device's clock
   std::vector<std::int64_t> sequence;    // 1: the device's sample number (-1: none)
   std::vector<std::int64_t> new_samples; // 1: new samples since the tick before (-1: not known)
-  bool counted = true;                   // the table has sequence and new_samples (session 4 on)
+  bool counted = true;                   // the table has sequence and new_samples (optional)
   std::vector<bool> overrun;             // the recorded run's pacing
   bool mapped = false;                   // the run mapped the samples (else device frame = world)
   hw::WorkspaceMapping mapping;          // parsed back exactly from the table's `mapping`

@@ -13,6 +13,7 @@
 #include <exception>
 #include <memory>
 #include <numeric>
+#include <new>
 #include <optional>
 #include <sstream>
 #include <thread>
@@ -25,6 +26,7 @@
 #include "graspsim/engine/state_hash.hpp"
 #include "graspsim/hw/mapped_device.hpp"
 #include "graspsim/hw/sample_clock.hpp"
+#include "graspsim/hw/sample_check.hpp"
 #include "graspsim/hw/sample_counter.hpp"
 #include "graspsim/hw/scripted_finger.hpp"
 #include "graspsim/recordings/trace_recorder.hpp"
@@ -103,6 +105,8 @@ constexpr int kFlushesInFlight = 1;
 constexpr double kFlushWall = 0.9;         // s, wall (under 1 s, with the check interval's slack)
 constexpr std::int64_t kWallCheckTicks = 64;
 
+}  // namespace
+
 // Servo ticks between flushes on simulated time: the largest whole number of physics (and
 // haptic) periods within kFlushSimulated / (kFlushesInFlight + 1), so that every flush interval
 // holds the same number of rows of every loop and each table's chunk can be exactly one interval
@@ -116,6 +120,8 @@ std::int64_t flush_interval_ticks(const Model& model) {
   const std::int64_t period = std::lcm(d.haptic, d.physics);
   return period <= limit ? limit / period * period : limit;
 }
+
+namespace {
 
 constexpr std::size_t kNoColumn = static_cast<std::size_t>(-1);
 
@@ -325,6 +331,9 @@ RunResult run_scenario(const scripting::Scenario& scenario, const RunOptions& op
     }
     started = true;
     writer.set_attribute("devices", device_list.str());
+    // Every sample is checked (finite, inside the device's workspace) before the engine sees it.
+    std::vector<hw::SampleCheck> checks;
+    for (std::size_t f = 0; f < devices.size(); ++f) checks.emplace_back(*devices[f], model.fingers[f].name);
     std::vector<hw::DeviceSample> samples(devices.size());   // this tick's, as read (world)
     // The scripts of fingers whose device does not run them (RunOptions::script_alongside).
     std::vector<std::unique_ptr<hw::Trajectory>> side_scripts(devices.size());
@@ -410,6 +419,7 @@ RunResult run_scenario(const scripting::Scenario& scenario, const RunOptions& op
       for (std::size_t f = 0; f < devices.size(); ++f) {
         if (side_scripts[f]) side_scripts[f]->sample(t);   // for what the script keeps; output unused
         samples[f] = devices[f]->read(n, t);
+        checks[f].check(samples[f], n, t);   // throws: the run stops with the device's fault
         input.fingers[f].hip = samples[f].position;
         input.fingers[f].gimbal = samples[f].gimbal;
       }
@@ -472,7 +482,7 @@ RunResult run_scenario(const scripting::Scenario& scenario, const RunOptions& op
       }
       if (recorder) {
         recorder->record(record, rendered, input, sim.state());
-        // A countdown, not (n + 1) % flush_ticks: a 64-bit division every tick was an eighth
+        // A countdown, not (n + 1) % flush_ticks: a 64-bit division every tick would be an eighth
         // of what logging cost the run loop (perf, the 40 s lift).
         if (--until_flush == 0 ||
             (n % kWallCheckTicks == 0 && seconds_since(last_flush) >= kFlushWall)) {
@@ -545,6 +555,11 @@ RunResult run_scenario(const scripting::Scenario& scenario, const RunOptions& op
       else initial = snapshot(sim, record, slip);
     }
     check_due(run_ticks);
+  } catch (const std::bad_alloc&) {
+    // The estimate before the run (run_budget.hpp) leaves room; this is the machine running out
+    // anyway (another process took it), said as such rather than as a bare "std::bad_alloc".
+    result.error = "out of memory after " + std::to_string(result.servo_ticks) +
+                   " servo ticks: the machine could not give the run the memory it asked for";
   } catch (const std::exception& e) {
     result.error = e.what();
   }

@@ -49,7 +49,7 @@ struct RunOptions {
   // (empty: none; the fingers of non-scripted devices, DevicePlan::recorded()).
   std::vector<bool> record_devices;
   // Whether /devices tables get the `sequence` and `new_samples` columns (false: a replay of a
-  // trace written before they existed, so that the replay can equal it).
+  // trace whose tables lack them, so that the replay can equal it).
   bool device_counters = true;
   // Fingers whose device does not run the finger's script itself (udp, phantom; empty: none,
   // DevicePlan::script_alongside()): the run evaluates that script at every tick before the
@@ -83,6 +83,10 @@ struct RunOptions {
   // a device.
   bool wait_for_script = false;
 };
+
+// Servo ticks between two flushes of the trace on simulated time (about 0.25 s): also every
+// table's block and chunk, in rows of its loop (run.cpp; run_budget.hpp counts on it).
+std::int64_t flush_interval_ticks(const Model& model);
 
 // A device whose samples carry their recorded overrun flag (a replay of /devices rows): the
 // run loop records that flag instead of its own pacing's, so a replay rewrites the same rows.

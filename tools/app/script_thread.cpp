@@ -42,7 +42,7 @@ hw::TrajectorySample PrefetchedTrajectory::sample(double t) {
   // another rounding of the same instant (a device clock's j / 1000 for k = 3 j at 3 kHz).
   if (k < 0 || !(std::fabs(t - static_cast<double>(k) / rate) <= 1e-9)) {
     // No servo tick at t: the script's sample of the tick before it (a zero-order hold of the
-    // servo-rate script), counted. Before this, the first such request returned the zero
+    // servo-rate script), counted. Without it the first such request would return the zero
     // sample nobody computed (a sim-phantom at 1 kHz under a 1500 Hz loop: the hand at the
     // origin).
     ++f.off_grid;

@@ -1,4 +1,4 @@
-// Lua off the real-time thread (issue 6, item 5; README.md "Devices", scripting/README.md
+// Lua off the real-time thread (README.md "Devices", scripting/README.md
 // "Threads"). In a paced run every Lua trajectory is sampled ahead of the loop, on a script
 // thread, into a bounded single-producer single-consumer ring per trajectory; the loop's thread
 // only takes samples out (two atomics, no lock, no allocation). A ring that runs dry holds the

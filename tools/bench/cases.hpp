@@ -1,6 +1,6 @@
-// The hard cases of the work-precision benchmark (issue 5), built from engine Models only (no
-// Lua, no trace): each runs one configuration (physics rate, gyroscopic option) and returns what
-// its error and stability are measured from. Shared by graspsim_bench and tests/bench.
+// The hard cases of the work-precision benchmark (tools/bench/README.md), built from engine Models
+// only (no Lua, no trace): each runs one configuration (physics rate, gyroscopic option) and
+// returns what its error and stability are measured from. Shared by graspsim_bench and tests/bench.
 #pragma once
 
 #include <array>

@@ -1,6 +1,6 @@
-// Free body micro-benchmark (issue 5, item 5): the cost of one physics step of a free body (no
-// floor, no fingers, no other body) against a bare Eigen explicit-Euler loop doing the same
-// arithmetic with nothing around it. Prints the median over repeats of ns per step for:
+// Free body micro-benchmark (README.md, "Speed targets"): the cost of one physics step of a free
+// body (no floor, no fingers, no other body) against a bare Eigen explicit-Euler loop doing the
+// same arithmetic with nothing around it. Prints the median over repeats of ns per step for:
 //   bare Euler      v += dt F/m, x += dt v, w += dt R (R^T T ./ J), R = (I + S(w) dt) R
 //   bare + n-o-a    the same with the paper's n-o-a re-orthonormalisation of R
 //   integrate_body  the engine's integrator alone (kNeglect: the paper's update, normalised)

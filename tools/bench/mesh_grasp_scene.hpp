@@ -1,6 +1,6 @@
-// The real-time profile's scene (issue 5, item 3), built in C++ with the engine alone: three
-// fingers grasp a 5,120-triangle pebble resting on the floor, lift it 3 cm and hold it, while a
-// box rests untouched on the floor nearby. Shared by tools/bench/profile.cpp and the allocation
+// The real-time profile's scene (engine/README.md, "Speed"), built in C++ with the engine alone:
+// three fingers grasp a 5,120-triangle pebble resting on the floor, lift it 3 cm and hold it, while
+// a box rests untouched on the floor nearby. Shared by tools/bench/profile.cpp and the allocation
 // test (tests/engine/test_no_allocation.cpp), so both see the same scene.
 //
 //   pebble   an icosphere of level 4 (20 x 4^4 = 5,120 triangles, 2,562 vertices) scaled to a

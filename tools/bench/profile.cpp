@@ -1,7 +1,8 @@
-// Real-time profile (issue 5, item 3): per-tick wall time of the servo, haptic and physics loops
-// for a three-finger grasp of a 5,120-triangle mesh (tools/bench/mesh_grasp_scene.hpp), with the
-// engine alone (no Lua, no trace, no device). Each Simulation::step call is timed with
-// steady_clock around it (the clock stays out of engine/) and filed by which loops ran in it:
+// Real-time profile (engine/README.md, "Speed"): per-tick wall time of the servo, haptic and
+// physics loops for a three-finger grasp of a 5,120-triangle mesh
+// (tools/bench/mesh_grasp_scene.hpp), with the engine alone (no Lua, no trace, no device). Each
+// Simulation::step call is timed with steady_clock around it (the clock stays out of engine/) and
+// filed by which loops ran in it:
 //   servo     a tick with the servo loop only (finger forces)
 //   +haptic   a tick where the haptic loop ran too (entry, walk, friction cone), no physics
 //   +physics  a tick where all three ran (body contact, floor, integration, broadphase update)

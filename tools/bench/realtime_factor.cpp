@@ -1,7 +1,7 @@
-// Real-time factor benchmark (issue 5, item 5): a scenario run through the whole run loop
-// (app::run_scenario: Lua trajectories, devices, engine, expectations), with the trace off and on,
-// at the scenario's rates and with every loop at 3000 Hz. Prints the median wall time of the run
-// loop (RunResult::wall) over the repeats and the real-time factor, simulated s / wall s.
+// Real-time factor benchmark (README.md, "Speed targets"): a scenario run through the whole run
+// loop (app::run_scenario: Lua trajectories, devices, engine, expectations), with the trace off and
+// on, at the scenario's rates and with every loop at 3000 Hz. Prints the median wall time of the
+// run loop (RunResult::wall) over the repeats and the real-time factor, simulated s / wall s.
 // Not a test (tests never time things): run it by hand, on a quiet machine,
 //   ./build/tools/graspsim_realtime_factor [REPEATS] [SCENARIO]
 #include <algorithm>

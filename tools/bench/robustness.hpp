@@ -25,17 +25,17 @@ namespace graspsim::robustness {
 inline constexpr double kSceneRadius = 1.0;    // m
 inline constexpr double kFloorMargin = 0.01;   // m
 
-// A period-2 cycle: a velocity component of a body that reverses sign at every physics step,
-// above kFlipSpeed (m/s) or kFlipSpin (rad/s), for kFlipSteps steps in a row. That is the step's
-// own Nyquist mode (a period of two steps: 25 Hz at 50 Hz), which an explicit step shows when a
-// coupled mode is too stiff for it (its eigenvalue near or beyond -1: the lift rocking at
-// 11 rad/s). It is no motion of the scene: a physical oscillation sampled every step reverses at
-// every step only near half the physics rate, far above the soft couplings of the library's
-// scenes (two 400 N/m fingers on a 0.4 kg box: sqrt(2 k / m) = 45 rad/s, 7 Hz, a reversal every
-// 3.5 steps at 50 Hz), and backward Euler damps what it cannot resolve without alternating (its
-// eigenvalues 1 / (1 + i w h) have a positive real part). Eight reversals in a row (0.16 s at
-// 50 Hz) are no transient of a settling contact; the thresholds are a hundred times the speeds
-// the scenarios call "at rest" (0.1 mm/s and 1e-3 rad/s in their checks).
+// A period-2 cycle: a velocity component of a body that reverses sign at every physics step, above
+// kFlipSpeed (m/s) or kFlipSpin (rad/s), for kFlipSteps steps in a row. That is the step's own
+// Nyquist mode (a period of two steps: 25 Hz at 50 Hz), which an explicit step shows when a coupled
+// mode is too stiff for it (its eigenvalue near or beyond -1: the lift rocking at 11 rad/s,
+// README.md "Stability warnings"). It is no motion of the scene: a physical oscillation sampled
+// every step reverses at every step only near half the physics rate, far above the soft couplings
+// of the library's scenes (two 400 N/m fingers on a 0.4 kg box: sqrt(2 k / m) = 45 rad/s, 7 Hz, a
+// reversal every 3.5 steps at 50 Hz), and backward Euler damps what it cannot resolve without
+// alternating (its eigenvalues 1 / (1 + i w h) have a positive real part). Eight reversals in a row
+// (0.16 s at 50 Hz) are no transient of a settling contact; the thresholds are a hundred times the
+// speeds the scenarios call "at rest" (0.1 mm/s and 1e-3 rad/s in their checks).
 inline constexpr int kFlipSteps = 8;            // 1
 inline constexpr double kFlipSpeed = 0.01;     // m/s
 inline constexpr double kFlipSpin = 0.1;       // rad/s

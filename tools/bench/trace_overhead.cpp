@@ -1,12 +1,12 @@
-// Logging overhead benchmark (issue 4, item 2): the two-finger lift run with the trace off, on
-// (HDF5 writing on the writer thread, as `graspsim run` does), on with the writing on the run
-// loop's own thread, and on with --compress, interleaved, in one process. Prints, for each, the
-// median over the repeats of: the whole run_scenario call's wall time (creating the file,
-// writing its attributes, running, closing it); the run loop thread's CPU time over the whole
-// call (what logging costs the thread that steps the simulation and would serve the devices;
-// least sensitive to other processes on a shared machine); the process's CPU time (all
-// threads: the cost on one core); the overhead of logging as a share of each (1 - off/on); and
-// the trace size per simulated second.
+// Logging overhead benchmark (recordings/README.md, "Cost"): the two-finger lift run with the trace
+// off, on (HDF5 writing on the writer thread, as `graspsim run` does), on with the writing on the
+// run loop's own thread, and on with --compress, interleaved, in one process. Prints, for each, the
+// median over the repeats of: the whole run_scenario call's wall time (creating the file, writing
+// its attributes, running, closing it); the run loop thread's CPU time over the whole call (what
+// logging costs the thread that steps the simulation and would serve the devices; least sensitive
+// to other processes on a shared machine); the process's CPU time (all threads: the cost on one
+// core); the overhead of logging as a share of each (1 - off/on); and the trace size per simulated
+// second.
 // Not a test (tests never time things): run it by hand on an idle machine,
 //   ./build/tools/bench_trace_overhead [REPEATS] [SCENARIO] [DURATION_S] [NAME=VALUE...]
 // (the NAME=VALUE arguments are --set overrides, e.g. rates.physics=3000 rates.haptic=3000)

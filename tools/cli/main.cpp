@@ -16,6 +16,7 @@
 #include "app/devices.hpp"
 #include "app/pacer.hpp"
 #include "app/run.hpp"
+#include "app/run_budget.hpp"
 #include "cli/repair.hpp"
 #include "cli/replay.hpp"
 #include "cli/report.hpp"
@@ -85,8 +86,9 @@ constexpr const char* kHelp =
     "physics step to the next, naming its motion, its springs and the rate that holds it.\n"
     "\n"
     "exit status: 0 every expectation held, 1 an expectation failed, 2 bad input (arguments,\n"
-    "scenario, output path, a device that cannot be opened, an error in the script while it\n"
-    "ran, or a refused unstable mode), 3 the trace could not be written to its end (a full\n"
+    "scenario, output path, a device that cannot be opened or a sample out of its workspace,\n"
+    "an error in the script while it ran, a refused unstable mode, or a blow-up: bodies no\n"
+    "finger touches gaining energy), 3 the trace could not be written to its end (a full\n"
     "disk: it keeps every tick up to its last flush, marked \"error: ...\"), 128 + the signal\n"
     "when stopped by SIGINT (130), SIGHUP (129) or SIGTERM (143).\n"
     "The trace is written as FILE.h5.partial, locked (a second run on the same output refuses),\n"
@@ -325,6 +327,13 @@ int run_command(const std::vector<std::string>& args) {
     if (tty) std::fprintf(stderr, "\r%60s\r", "");
     std::cerr << "graspsim: warning: " << w << "\n";
   };
+
+  // A run that will not fit (memory for its trace buffers, disk for its trace) is refused
+  // before anything is written (README.md "Run length and rates").
+  std::string size_warning;
+  const std::string too_big = graspsim::app::check_run_fits(*scenario, options, &size_warning);
+  if (!too_big.empty()) return bad_input(too_big);
+  if (!size_warning.empty()) std::cerr << "graspsim: warning: " << size_warning << "\n";
 
   graspsim::app::RunResult result;
   try {

@@ -9,6 +9,7 @@
 #include <iostream>
 
 #include "app/replay.hpp"
+#include "app/run_budget.hpp"
 #include "app/run.hpp"
 #include "cli/report.hpp"
 #include "graspsim/recordings/trace_compare.hpp"
@@ -122,6 +123,11 @@ int replay_command(const std::vector<std::string>& args, const std::atomic<bool>
   options.interrupt = interrupt;
   options.interrupt_signal = signal;
   options.inputs.push_back({trace, "the trace replayed"});
+  // The replay's trace is as large as the recording: refused if it will not fit.
+  std::string size_warning;
+  const std::string too_big = app::check_run_fits(*plan.scenario, options, &size_warning);
+  if (!too_big.empty()) return bad_input("replay: " + too_big);
+  if (!size_warning.empty()) std::cerr << "graspsim: warning: " << size_warning << "\n";
   app::RunResult result;
   try {
     result = app::run_scenario(*plan.scenario, options);

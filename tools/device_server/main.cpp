@@ -38,6 +38,10 @@ prints the forces (N) it receives.
                       next sample (a lost one is replaced by a repeat of the last one sent).
                       Every sample declares the mode: lockstep with this option, streaming
                       without (the client's `,lockstep` must match, or it refuses to run)
+                      Streaming, the clock starts with the client's run: a hello is answered
+                      with sample 0 (at device time 0), and the first force (the run's first
+                      tick) starts the clock, so that sample k goes out (k - 1) / rate after it,
+                      in time for the run's tick k. A hello from another client starts again
   motion (default: --motion line):
   --motion line       from --from to --to (m, "x,y,z") in --duration s, then hold
   --motion circle     --center "x,y,z" (m), --radius m, --period s, in the x-y plane
@@ -249,7 +253,9 @@ int serve(const Options& o) {
   std::uint64_t k = 0, forces = 0, hellos = 0, malformed = 0, sent = 0, lost = 0;
   udp::Sample last_sent;
   bool any_sent = false;
-  const double start = monotonic();
+  // Streaming: the device's clock (s, monotonic) at sample 0; running once the first force came.
+  double start = monotonic();
+  bool clock_running = false;
   double last_heard = start;
 
   const auto lost_sample = [&](std::uint64_t seq) {
@@ -288,9 +294,23 @@ int serve(const Options& o) {
     if (type == udp::MessageType::kHello) {
       udp::Hello h;
       if (udp::decode(b, static_cast<std::size_t>(n), &h) != udp::DecodeStatus::kOk) return ++malformed, false;
+      const bool other = have_client && (from.sin_addr.s_addr != client.sin_addr.s_addr || from.sin_port != client.sin_port);
+      if (!o.lockstep && other) {
+        k = 0;   // another client's run: the playback starts again
+        any_sent = false;
+        clock_running = false;
+      }
       client = from;
       have_client = true;
       ++hellos;
+      if (!o.lockstep && !clock_running) {
+        // The handshake: sample 0, again for a repeated hello (the client resends until one comes).
+        if (k == 0) produce(0.0);
+        else if (any_sent) {
+          std::uint8_t again[udp::kSampleSize];
+          ::sendto(fd, again, udp::encode(last_sent, again), 0, reinterpret_cast<const sockaddr*>(&client), sizeof client);
+        }
+      }
       return true;
     }
     udp::Force f;
@@ -299,6 +319,11 @@ int serve(const Options& o) {
       return false;
     }
     if (!have_client) return false;   // a force before any hello: nobody to answer
+    if (!o.lockstep && !clock_running) {
+      // The run's tick 0 has read sample 0 and sent this force: sample 1 is due now, for tick 1.
+      start = monotonic() - 1.0 / rate;
+      clock_running = true;
+    }
     ++forces;
     if (forces % print_every == 0) {
       std::printf("force seq=%u answers=%u F=%.17g,%.17g,%.17g N\n", f.sequence, f.answers, f.force[0], f.force[1],
@@ -318,7 +343,8 @@ int serve(const Options& o) {
     }
     // Lockstep waits for the next datagram; streaming polls until the next sample is due.
     const double due = start + static_cast<double>(k) / rate;
-    const double wait = o.lockstep || !have_client ? 0.1 : std::max(0.0, due - now);
+    const bool streaming = !o.lockstep && have_client && clock_running;
+    const double wait = streaming ? std::max(0.0, due - now) : 0.1;
     pollfd p{fd, POLLIN, 0};
     if (::poll(&p, 1, static_cast<int>(std::ceil(wait * 1000.0))) > 0) {
       sockaddr_in from{};
@@ -331,7 +357,7 @@ int serve(const Options& o) {
       }
       continue;
     }
-    if (!o.lockstep && have_client && monotonic() >= due) {
+    if (streaming && monotonic() >= due) {
       if (finished()) break;
       produce(monotonic() - start);
     }

@@ -79,6 +79,7 @@ int bless(const std::string& scenario_file, const fs::path& work, bool dry_run, 
   golden::decimate_trace(full, fresh);
   const auto size = fs::file_size(fresh);
   bool changed = true;
+  std::string what;   // what this bless changes, kept in the golden (root attribute blessed_changes)
   if (fs::exists(golden)) {
     try {
       recordings::CompareOptions options;
@@ -87,22 +88,34 @@ int bless(const std::string& scenario_file, const fs::path& work, bool dry_run, 
       changed = !result.same() || result.unmatched_ticks() > 0;
       bool rule_changed = false;   // same values, but kept or stored another way
       for (const auto& a : result.attributes) rule_changed = rule_changed || a.name == "golden";
-      if (!changed && rule_changed) std::cout << "  same values where ticks meet, but the golden's rule changed\n";
+      if (!changed && rule_changed) {
+        what = "same values where ticks meet, but the golden's rule changed";
+        std::cout << "  " << what << "\n";
+      }
       if (!changed && !rule_changed) {
         std::cout << "  unchanged: bit-identical to " << golden << " on every row; left as it is\n";
         return 0;
       }
-      std::cout << "  changed:\n" << golden::divergence_summary(result);
+      if (changed) {
+        what = "changed against the golden before:\n" + golden::divergence_summary(result);
+        std::cout << "  changed:\n" << golden::divergence_summary(result);
+      }
     } catch (const recordings::CompareInputError& e) {
-      std::cout << "  the old golden cannot be compared (" << e.what() << ")\n";
+      what = std::string("the golden before could not be compared (") + e.what() + ")";
+      std::cout << "  " << what << "\n";
     }
   } else {
+    what = "new: no golden before";
     std::cout << "  new: no golden yet\n";
   }
+  if (failing) what += "\nblessed with --allow-failing: the run fails an expectation (the golden test fails it)";
   if (dry_run) {
     std::cout << "  dry run: " << golden << " not written\n";
     return 1;
   }
+  golden::DecimateOptions kept;
+  kept.blessed_changes = what;
+  golden::decimate_trace(full, fresh, kept);
   fs::create_directories(fs::path(golden).parent_path());
   fs::copy_file(fresh, golden, fs::copy_options::overwrite_existing);
   std::cout << "  wrote " << golden << " (" << kilobytes(size) << ", " << run.physics_ticks

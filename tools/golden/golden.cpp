@@ -252,7 +252,7 @@ void decimate_trace(const std::string& in, const std::string& out, const Decimat
     // No time stamp on the root group either: a golden's bytes depend on its content only.
     check(H5Pset_obj_track_times(fcpl.get(), 0), "cannot create '" + temporary + "'");
     // The 1.10 format, as the traces: a dataset of one chunk has a "single chunk" index of a
-    // few bytes instead of a 1.8 B-tree of ~1 kB, which was 60% of a small golden.
+    // few bytes instead of a 1.8 B-tree of ~1 kB, which would be 60% of a small golden.
     Id fapl(H5Pcreate(H5P_FILE_ACCESS), H5Pclose, "cannot create '" + temporary + "'");
     check(H5Pset_libver_bounds(fapl.get(), H5F_LIBVER_LATEST, H5F_LIBVER_LATEST), "cannot create '" + temporary + "'");
     Id dst(H5Fcreate(temporary.c_str(), H5F_ACC_TRUNC, fcpl.get(), fapl.get()), H5Fclose,
@@ -264,6 +264,8 @@ void decimate_trace(const std::string& in, const std::string& out, const Decimat
                                   stride, options.compression),
                            "'" + temporary + "'");
     write_string_attribute(dst.get(), "golden_cpu", cpu_model(), "'" + temporary + "'");
+    if (!options.blessed_changes.empty())
+      write_string_attribute(dst.get(), "blessed_changes", options.blessed_changes, "'" + temporary + "'");
     const Copier copier{in, options.compression};
     for (const std::string& name : link_names(src.get(), where)) {
       const std::string path = "/" + name;

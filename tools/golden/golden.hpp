@@ -23,18 +23,20 @@ std::string bless_command(const std::string& scenario_file);
 // own rates and duration, full trace (every row, uncompressed) to `trace`.
 app::RunResult run_for_golden(const std::string& scenario_file, const std::string& trace);
 
-// How a full trace becomes a golden: the rows of every table whose tick is a multiple of
-// `stride` servo ticks; 0 means rate_servo / min(rate_physics, kGoldenRowsPerSecond), i.e. every
-// /physics row (with the state hash of the whole State) and the /servo and /haptic rows at
-// physics ticks, up to 500 physics rows per simulated second (a 3 kHz physics loop keeps every
-// 6th: a golden of a 2 s stack at 3 kHz was 2.1 MB; any divergence persists to a kept tick). Shuffle + deflate at
-// `compression` (1..9). Root and dataset attributes are copied; the root gets `golden` (what
-// was kept) and `golden_cpu` (the CPU model it was blessed on).
+// How a full trace becomes a golden: the rows of every table whose tick is a multiple of `stride`
+// servo ticks; 0 means rate_servo / min(rate_physics, kGoldenRowsPerSecond), i.e. every /physics
+// row (with the state hash of the whole State) and the /servo and /haptic rows at physics ticks, up
+// to 500 physics rows per simulated second (a 3 kHz physics loop keeps every 6th: every row of a
+// 2 s stack at 3 kHz would make a 2.1 MB golden; any divergence persists to a kept tick). Shuffle +
+// deflate at `compression` (1..9). Root and dataset attributes are copied; the root gets `golden`
+// (what was kept) and `golden_cpu` (the CPU model it was blessed on).
 inline constexpr std::int64_t kGoldenRowsPerSecond = 500;   // most physics rows kept per s
 
 struct DecimateOptions {
   std::int64_t stride = 0;   // servo ticks
   int compression = 9;
+  std::string blessed_changes;   // root attribute `blessed_changes` when not empty: what the bless
+                                 //    that wrote this golden changed against the one before
 };
 
 // Writes the decimated copy of trace `in` to `out` (replacing it). Throws

@@ -33,6 +33,10 @@ Vec3 box_vertex(const Vec3& half_extents, int k);
 inline constexpr int kCylinderRimPoints = 12;
 int floor_point_count(const Shape& shape);
 
+// m: how far from its centre of mass a body reaches the floor in any orientation: its farthest
+// floor point (a rolling point is at radius r from a centre point; the capsule's at L + r).
+double floor_reach(const Shape& shape);
+
 // Floor point k of a body turned by `rotation`, as an offset (m, world) from its centre of mass.
 // `rolling` says the point is not a fixed material point but the lowest point of a round surface
 // (sphere, capsule end), which the body rolls over.

@@ -19,6 +19,26 @@ struct DeviceSample {
   std::uint32_t buttons = 0;      // bit i set while button i is pressed
 };
 
+// A box in a device's own frame (the frame of its samples, before a workspace mapping): where
+// its samples may be. A sample outside it, or not finite, never reaches the engine (SampleCheck).
+struct Workspace {
+  Vec3 min{0.0, 0.0, 0.0};   // m: lower corner
+  Vec3 max{0.0, 0.0, 0.0};   // m: upper corner
+  bool contains(const Vec3& p) const;   // false for a NaN
+};
+
+// Workspaces for devices that do not know theirs exactly (hw/README.md, "Sample checks"):
+// - kDeviceReach: a device's own frame, |x|, |y|, |z| <= 1 m about its origin. The largest
+//   desktop haptic device spans 0.38 m (the Premium 1.5), and a server's origin may sit off its
+//   workspace's centre; no hand on such a device reaches 1 m, while 1e300, or an encoder read as
+//   garbage, is far outside. A scaled workspace mapping then multiplies the reach in the world.
+// - kWorldReach: world-frame samples with no device behind them (a script, a replayed trace), up
+//   to 1 km from the origin: further than any scene, and small enough that squares of positions
+//   (distances in contact tests) stay far from overflow with 13 digits left below a micrometre.
+inline constexpr double kDeviceReach = 1.0;     // m
+inline constexpr double kWorldReach = 1000.0;   // m
+Workspace reach_box(double half_side);          // [-half_side, half_side]^3, m
+
 struct DeviceLimits {
   double max_force = 10.0;   // N: largest force magnitude the device may render
 };
@@ -46,6 +66,9 @@ class Device {
   }
   virtual DeviceLimits limits() const = 0;
   virtual std::string describe() const = 0;   // for messages and the trace, e.g. "scripted"
+  // Where this device's samples may be, in its own frame: reach_box(kDeviceReach) unless the
+  // device knows better (a simulated Phantom: its box) or has no device frame (kWorldReach).
+  virtual Workspace workspace() const { return reach_box(kDeviceReach); }
 
  protected:
   // Sends an already clamped force to the hardware (or stores it).

@@ -41,6 +41,7 @@ class MappedDevice final : public Device {
   DeviceSample read(std::int64_t tick, double time) override;
   DeviceLimits limits() const override { return device_->limits(); }
   std::string describe() const override;
+  Workspace workspace() const override { return device_->workspace(); }   // the device frame's
   const DeviceSample& last_device_sample() const { return last_sample_; }   // device frame
   const Vec3& last_device_force() const { return last_force_; }             // N, device frame
   Device& inner() { return *device_; }

@@ -29,6 +29,7 @@ class ReplayDevice final : public Device {
   DeviceSample read(std::int64_t tick, double time) override;
   DeviceLimits limits() const override { return limits_; }
   std::string describe() const override { return "replay of " + source_; }
+  Workspace workspace() const override { return reach_box(kWorldReach); }   // world frame, no device
   std::int64_t ticks() const { return static_cast<std::int64_t>(positions_.size()); }
   const Vec3& last_force() const { return last_force_; }   // N, world: last rendered force
 

@@ -2,7 +2,7 @@
 // that clock (a UDP device's `device time`, a Phantom's scheduler time). The run loop records it
 // in /devices/<finger>/device_time; a device without one is recorded with the simulated time of
 // the servo tick that read it. Implemented alongside Device (class X : public Device, public
-// SampleClock); the run loop finds it with dynamic_cast, so device.hpp is unchanged.
+// SampleClock); the run loop finds it with dynamic_cast, so Device needs no member for it.
 #pragma once
 
 namespace graspsim::hw {

@@ -15,6 +15,7 @@ class ScriptedFinger final : public Device {
   DeviceSample read(std::int64_t tick, double time) override;
   DeviceLimits limits() const override { return limits_; }
   std::string describe() const override { return "scripted"; }
+  Workspace workspace() const override { return reach_box(kWorldReach); }   // world frame, no device
   const Vec3& last_force() const { return last_force_; }   // N, world: last rendered force
 
  protected:

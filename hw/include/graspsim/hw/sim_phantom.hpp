@@ -63,6 +63,9 @@ class SimPhantom final : public Device {
   DeviceSample read(std::int64_t tick, double time) override;
   DeviceLimits limits() const override { return DeviceLimits{model_.peak_force}; }
   std::string describe() const override;
+  // Its box (the encoder never reads outside it), widened by one count for the rounding of
+  // centre + count x resolution.
+  Workspace workspace() const override;
 
   const DeviceModel& model() const { return model_; }
   const ForceSafety& safety() const { return safety_; }

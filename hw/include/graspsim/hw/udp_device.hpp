@@ -46,7 +46,8 @@ struct UdpDeviceConfig {
   std::string model = kUdpDefaultModel;   // where `safety` came from, for describe()
 };
 
-// Counts since the device was made. DEVCLI records them in the trace.
+// Counts since the device was made (the trace has the per-tick `sequence` and `new_samples`
+// instead: hw::SampleCounter).
 struct UdpCounters {
   std::uint64_t received = 0;    // samples accepted (newer than every sample before)
   std::uint64_t lost = 0;        // sample sequence numbers skipped between accepted samples

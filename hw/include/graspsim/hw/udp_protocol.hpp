@@ -16,8 +16,8 @@
 namespace graspsim::hw::udp {
 
 inline constexpr std::array<std::uint8_t, 4> kMagic = {'G', 'S', 'D', 'V'};   // bytes 0-3
-// Bumped on any change of layout or meaning. 2: every sample declares the server's mode (v1
-// could not, so a client's `,lockstep` was the user's word alone); v1 datagrams are refused.
+// Bumped on any change of layout or meaning. 2: every sample declares the server's mode, so a
+// client's `,lockstep` is not the user's word alone (v1 has no mode); v1 datagrams are refused.
 inline constexpr std::uint16_t kVersion = 2;
 
 enum class MessageType : std::uint16_t { kHello = 1, kSample = 2, kForce = 3 };

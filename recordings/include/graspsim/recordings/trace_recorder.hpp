@@ -19,8 +19,21 @@ namespace graspsim::recordings {
 // 2: one group per loop, one dataset per column. Readers here read both.
 inline constexpr std::int64_t kSchemaVersion = 3;
 
+// One row of a table: doubles in the writer's memory blocks, bytes in the file.
+struct RowSize {
+  std::size_t values = 0;   // doubles per row in memory (TraceTable::row_width)
+  std::size_t bytes = 0;    // bytes per stored compound row
+};
+
 class TraceRecorder {
  public:
+  // The rows the constructor declares for `model`, for estimates before a run (the memory a
+  // writer holds, the disk a trace takes): /servo, /haptic, /physics.
+  struct Rows {
+    RowSize servo, haptic, physics;
+  };
+  static Rows row_sizes(const graspsim::Model& model);
+
   // Declares every table and column (and their attributes) in `writer`, which must outlive
   // the recorder. Throws std::invalid_argument for a finger or object name that cannot be an
   // HDF5 group name (empty, ".", "..", or containing '/'). `chunk_ticks` > 0: each table's

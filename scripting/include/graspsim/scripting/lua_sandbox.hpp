@@ -76,6 +76,13 @@ class LuaSandbox {
 
   std::size_t memory_used() const { return used_bytes_; }   // bytes
 
+  // Charges `steps` units of work done in C on behalf of a script (a pattern match's steps,
+  // string.rep's and table.move's iterations: scripting/src/lua_patterns.hpp) to the running
+  // call's instruction budget, one unit per VM instruction. Once the budget is spent it raises
+  // the budget's Lua error in `state` (a longjmp: call it only where the Lua library could raise
+  // one) naming `what`; the count hook then fires at every instruction, as for a Lua loop.
+  static void charge(lua_State* state, long long steps, const char* what);
+
   // Thread guard (scripting/README.md "Threads"): while a thread is forbidden (a paced run's
   // real-time loop), every entry into this state from it is refused before the state is touched
   // (enter() throws ScenarioError) and every allocation made on it is counted. Both are one

@@ -92,6 +92,17 @@ struct Jitter {
   std::uint64_t seed = 0;   // 1
 };
 
+// Ceilings on a run's size, checked when a scenario loads (with its --set overrides), before any
+// memory or disk is committed to it (scripting/README.md, "Ceilings"):
+// - kMaxServoRate: a haptic servo loop runs at 1 to 10 kHz (OpenHaptics 1 kHz, the paper 3 kHz);
+//   10 times the fastest. The trace writer holds a quarter second of rows per table, so the
+//   rate decides its memory: at 100 kHz 25,000 rows a table.
+// - kMaxDuration: 24 h of simulated time, longer than any session with a hand on a device (the
+//   library's longest scenario runs 7.5 s); at 3 kHz, 259 million servo rows (63 GB for the lift).
+// What the machine can hold below them is checked before a run (tools/app/run_budget.hpp).
+inline constexpr int kMaxServoRate = 100'000;    // Hz
+inline constexpr double kMaxDuration = 86'400.0;  // s
+
 struct LoadOptions {
   // "--set name=value" overrides, applied to the scenario table before it is converted.
   std::vector<std::string> sets;
