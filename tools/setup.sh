@@ -14,11 +14,11 @@ graspsim_packages=(
   g++ make cmake pkg-config git
   libeigen3-dev libfcl-dev liblua5.4-dev libhdf5-dev catch2
   hdf5-tools
-  clang                             # the Clang twin (tests/golden/test_compiler_twin.cpp)
   python3-h5py python3-matplotlib   # tools/plot_trace.py; h5py also reads crash-cut traces in
                                     # SWMR mode in tests/e2e/test_crash.cpp
-  clang libclang-rt-dev             # the Clang twin, the sanitizer build (its runtimes) and
-                                    # libFuzzer (README.md "Sanitizers and fuzzing")
+  clang libclang-rt-dev             # the Clang twin (tests/golden/test_compiler_twin.cpp), the
+                                    # sanitizer build (its runtimes) and libFuzzer (README.md
+                                    # "Sanitizers and fuzzing")
 )
 
 graspsim_install_missing() {
