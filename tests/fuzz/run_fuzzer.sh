@@ -22,7 +22,7 @@ dict=""
 # Reports on stderr (not into files), symbolized; leaks are findings too.
 export ASAN_OPTIONS="detect_leaks=1:abort_on_error=0:symbolize=1"
 export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
-export LSAN_OPTIONS="suppressions=$source_dir/../lsan_suppressions.txt"
+export LSAN_OPTIONS="suppressions=$source_dir/../lsan_suppressions.txt:print_suppressions=0"
 log="$work/last-run.log"
 status=0
 # -close_fd_mask=1: the harness's stdout (a scenario's Lua print) is dropped; libFuzzer reports on stderr.
