@@ -1,4 +1,4 @@
-// libFuzzer harness: the scenario loader, Lua text in (README.md "Fuzzing").
+// libFuzzer harness: the scenario loader, Lua text in (README.md "Sanitizers and fuzzing").
 // Property: any text either loads or is refused with a ScenarioError (the loader's one
 // exception, scripting/error.hpp); a scenario that loads gives a model the engine either accepts
 // or refuses with std::invalid_argument (engine/simulation.hpp), and the accepted one steps for
@@ -25,7 +25,7 @@ using namespace graspsim;
 namespace {
 
 // Lower than a run's limits (256 MiB, 2e8 instructions) so one input takes milliseconds, not
-// seconds; the same budget and allocator code refuses both. 2e6 instructions: about 20 ms here.
+// seconds; the same budget and allocator code refuses both. 2e6 instructions: 9 to 20 ms here.
 scripting::LoadOptions fuzz_options() {
   scripting::LoadOptions options;
   options.limits.memory_mib = 64;
