@@ -112,7 +112,9 @@ void Simulation::servo_stage(const Input& input, TickRecord& record) {
     if (b >= 0) {
       BodyState& bs = state_.bodies[b];
       bs.window_force -= force;
-      bs.window_torque += (contact_point - fast_loop_pose(model_, bs, state_.tick).position).cross(-force);
+      // About the centre as the fast loops see it (local_model.hpp; the physics pose without it).
+      const Vec3 centre = uses_local_model(model_) ? fast_loop_pose(model_, bs, state_.tick).position : bs.position;
+      bs.window_torque += (contact_point - centre).cross(-force);
       if (model_.integrator == Integrator::kImplicit) state_.fingers[f].window_force -= force;
     }
   }

@@ -26,6 +26,7 @@
 #include "graspsim/recordings/trace_reader.hpp"
 #include "graspsim/scripting/scenario.hpp"
 #include "tests/support/shell.hpp"
+#include "tests/support/library.hpp"
 
 using namespace graspsim;
 
@@ -368,10 +369,7 @@ TEST_CASE("Every library scenario with its first finger on replay: reproduces it
   // the same scenario with its first finger switched to replay:<that run> (the other fingers still
   // scripted, Lua feedback controllers included) gives the same state hash at every physics tick
   // and the same expectation results (law: determinism in the inputs; no tolerance).
-  std::vector<std::string> files;
-  for (const auto& e : std::filesystem::directory_iterator(kSource + "/scenarios"))
-    if (e.path().extension() == ".lua") files.push_back(e.path().string());
-  std::sort(files.begin(), files.end());
+  const std::vector<std::string> files = graspsim::test::library_scenarios();
   REQUIRE(files.size() >= 20);
   const app::DeviceRegistry registry = app::default_registry();
   for (const std::string& file : files) {

@@ -8,17 +8,14 @@
 
 #include "app/run.hpp"
 #include "graspsim/scripting/scenario.hpp"
+#include "tests/support/library.hpp"
 
 // A scenario states what it shows and checks it: a run that ends early or fails an expectation
 // fails here, naming the scenario and the expectation. Files are taken in sorted order. Each
 // runs at its own rates (the paper's 3000/500/50 Hz) and with every loop at 3000 Hz: the
 // physics must not depend on the paper's slow physics loop to work.
 TEST_CASE("every scenario in scenarios/ meets its expectations at two sets of rates", "[e2e][scenario]") {
-  std::vector<std::string> files;
-  for (const auto& entry : std::filesystem::directory_iterator(std::string(GRASPSIM_SOURCE_DIR) + "/scenarios")) {
-    if (entry.path().extension() == ".lua") files.push_back(entry.path().string());
-  }
-  std::sort(files.begin(), files.end());
+  const std::vector<std::string> files = graspsim::test::library_scenarios();
   REQUIRE(files.size() >= 2);
   const std::vector<std::vector<std::string>> rate_sets = {
       {}, {"rates.servo=3000", "rates.haptic=3000", "rates.physics=3000"}};

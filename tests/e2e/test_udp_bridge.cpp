@@ -17,6 +17,7 @@
 #include "graspsim/recordings/trace_reader.hpp"
 #include "graspsim/scripting/scenario.hpp"
 #include "tests/support/shell.hpp"
+#include "tests/support/library.hpp"
 
 using namespace graspsim::hw;
 
@@ -287,10 +288,7 @@ TEST_CASE("graspsim run with a finger on the UDP bridge and its replay are bit f
 TEST_CASE("Every library scenario with its first finger on the UDP bridge reproduces its scripted run", "[e2e][udp][devices][scenarios]") {
   const std::string cli = GRASPSIM_CLI;
   const std::string tmp = GRASPSIM_TEST_TMP;
-  std::vector<std::string> files;
-  for (const auto& e : std::filesystem::directory_iterator(std::string(GRASPSIM_SOURCE_DIR) + "/scenarios"))
-    if (e.path().extension() == ".lua") files.push_back(e.path().string());
-  std::sort(files.begin(), files.end());
+  const std::vector<std::string> files = graspsim::test::library_scenarios();
   REQUIRE(files.size() >= 20);
   int driven = 0;
   for (const std::string& file : files) {

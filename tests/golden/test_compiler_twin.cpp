@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "graspsim/recordings/trace_reader.hpp"
+#include "tests/support/library.hpp"
 #include "tests/support/shell.hpp"
 #include "tests/support/skip.hpp"
 
@@ -21,13 +22,7 @@ namespace {
 const std::string kSource = GRASPSIM_SOURCE_DIR;
 const std::string kTmp = GRASPSIM_TEST_TMP;
 
-std::vector<std::string> library_scenarios() {
-  std::vector<std::string> files;
-  for (const auto& entry : fs::directory_iterator(kSource + "/scenarios"))
-    if (entry.path().extension() == ".lua") files.push_back(entry.path().string());
-  std::sort(files.begin(), files.end());
-  return files;
-}
+using graspsim::test::library_scenarios;
 
 }  // namespace
 

@@ -17,6 +17,7 @@
 #include "graspsim/recordings/trace_reader.hpp"
 #include "graspsim/scripting/scenario.hpp"
 #include "tests/support/shell.hpp"
+#include "tests/support/library.hpp"
 #include "tests/support/skip.hpp"
 #include "tests/support/trace_edit.hpp"
 
@@ -29,13 +30,7 @@ const std::string kSource = GRASPSIM_SOURCE_DIR;
 const std::string kGoldenDir = kSource + "/tests/golden";
 const std::string kTmp = GRASPSIM_TEST_TMP;
 
-std::vector<std::string> scenario_files() {
-  std::vector<std::string> files;
-  for (const auto& entry : fs::directory_iterator(kSource + "/scenarios"))
-    if (entry.path().extension() == ".lua") files.push_back(entry.path().string());
-  std::sort(files.begin(), files.end());
-  return files;
-}
+std::vector<std::string> scenario_files() { return graspsim::test::library_scenarios(); }
 
 using graspsim::test::Outcome;
 using graspsim::test::shell;

@@ -12,16 +12,13 @@
 #include "graspsim/recordings/trace_reader.hpp"
 #include "graspsim/recordings/trace_writer.hpp"
 #include "recordings/src/h5.hpp"
+#include "tests/support/library.hpp"
 
 using namespace graspsim::recordings;
 
 namespace {
 
-std::string tmp_path(const std::string& name) {
-  const std::string path = std::string(GRASPSIM_TEST_TMP) + "/recordings_" + name;
-  std::remove(path.c_str());
-  return path;
-}
+std::string tmp_path(const std::string& name) { return graspsim::test::fresh_tmp_path("recordings_", name); }
 
 // Rows of table /t a reader sees now (0 before the table is in the file).
 std::int64_t rows_on_disk(const std::string& file) {

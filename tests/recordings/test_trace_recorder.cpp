@@ -18,6 +18,7 @@
 #include "graspsim/engine/state_hash.hpp"
 #include "graspsim/recordings/trace_reader.hpp"
 #include "graspsim/recordings/trace_recorder.hpp"
+#include "tests/support/library.hpp"
 
 using namespace graspsim;
 using namespace graspsim::recordings;
@@ -53,11 +54,7 @@ void operator delete[](void* p, const std::nothrow_t&) noexcept { std::free(p); 
 
 namespace {
 
-std::string tmp_path(const std::string& name) {
-  const std::string path = std::string(GRASPSIM_TEST_TMP) + "/recordings_" + name;
-  std::remove(path.c_str());
-  return path;
-}
+std::string tmp_path(const std::string& name) { return graspsim::test::fresh_tmp_path("recordings_", name); }
 
 // 2 fingers, 1 box, servo 60 Hz, haptic 12 Hz (every 5th tick), physics 6 Hz (every 10th).
 Model small_model() {

@@ -18,16 +18,13 @@
 
 #include "graspsim/recordings/trace_reader.hpp"
 #include "graspsim/recordings/trace_writer.hpp"
+#include "tests/support/library.hpp"
 
 using namespace graspsim::recordings;
 
 namespace {
 
-std::string tmp_path(const std::string& name) {
-  const std::string path = std::string(GRASPSIM_TEST_TMP) + "/recordings_" + name;
-  std::remove(path.c_str());
-  return path;
-}
+std::string tmp_path(const std::string& name) { return graspsim::test::fresh_tmp_path("recordings_", name); }
 
 std::uint64_t bits(double x) { return std::bit_cast<std::uint64_t>(x); }
 
