@@ -6,7 +6,10 @@
 graspsim_root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 graspsim_build=${GRASPSIM_BUILD_DIR:-$graspsim_root/build}
 graspsim_cmake_env=()    # e.g. CC=clang CXX=clang++, for the first configure only
-graspsim_cmake_args=()   # extra -D options, for the first configure only
+# Extra -D options, for the first configure only. The main build (GCC) builds no Clang twin of
+# graspsim: tools/check compares the sanitizer build's graspsim, a Clang build, with this build's
+# instead (README.md, "Which build checks what").
+graspsim_cmake_args=(-DGRASPSIM_COMPILER_TWIN=OFF)
 
 # Everything graspsim needs from Debian 12, and nothing else. hdf5-tools gives h5dump and
 # h5ls for looking into traces.
@@ -73,11 +76,14 @@ graspsim_build() {
 
 # graspsim_use_sanitize_build: later graspsim_build calls build the sanitizer build instead, a
 # Clang build with AddressSanitizer, UndefinedBehaviorSanitizer and the fuzzers (GRASPSIM_SANITIZE
-# in CMakeLists.txt), without the twins the main build already tests.
+# in CMakeLists.txt), without the Debug twin the main build tests. Its GCC-vs-Clang test compares
+# its graspsim with the main build's (which tools/check builds first), so no Clang twin is built.
 graspsim_use_sanitize_build() {
+  local main_build=${GRASPSIM_BUILD_DIR:-$graspsim_root/build}
   graspsim_build=${GRASPSIM_SANITIZE_BUILD_DIR:-$graspsim_root/build-sanitize}
   graspsim_cmake_env=(CC=clang CXX=clang++)
-  graspsim_cmake_args=(-DGRASPSIM_SANITIZE=ON -DGRASPSIM_TWIN_BUILD=OFF -DGRASPSIM_COMPILER_TWIN=OFF)
+  graspsim_cmake_args=(-DGRASPSIM_SANITIZE=ON -DGRASPSIM_TWIN_BUILD=OFF
+                       -DGRASPSIM_COMPILER_TWIN_CLI="$main_build/tools/graspsim")
 }
 
 # graspsim_setup [TARGET...]
