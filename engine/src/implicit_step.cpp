@@ -50,13 +50,14 @@ Mat3 response(const Coupling& c, CouplingMode mode, const Vec3& slide, double h)
   return g_n * nn + g_t * (Mat3::Identity() - nn);
 }
 
-// The constant part of the force, force + (C + lead K) u0, in its mode; while sliding along t the
+// The constant part of the force, force + (C + lead K) u0 (`force`: the coupling's, less h/3 K
+// u_mean under BDF2), in its mode; while sliding along t the
 // tangential part is mu times the normal part, plus the viscous force.
-Vec3 constant_force(const Coupling& c, CouplingMode mode, const Vec3& u0, const Vec3& slide) {
+Vec3 constant_force(const Coupling& c, const Vec3& force, CouplingMode mode, const Vec3& u0, const Vec3& slide) {
   const Vec3& n = c.normal;
-  const double normal = n.dot(c.force) + (c.c_n + c.lead * c.k_n) * n.dot(u0);   // N
+  const double normal = n.dot(force) + (c.c_n + c.lead * c.k_n) * n.dot(u0);   // N
   if (mode == CouplingMode::kSlip) return normal * (n + c.mu * slide) + c.viscous * slide;
-  const Vec3 tangential = c.force - n.dot(c.force) * n + (c.c_t + c.lead * c.k_t) * (u0 - n.dot(u0) * n);
+  const Vec3 tangential = force - n.dot(force) * n + (c.c_t + c.lead * c.k_t) * (u0 - n.dot(u0) * n);
   return normal * n + tangential;
 }
 
@@ -132,6 +133,10 @@ ImplicitStep::ImplicitStep(const Model& model) {
   rhs_.resize(7 * n);
   v1_.resize(n);
   w1_.resize(n);
+  vq_.resize(n);
+  wq_.resize(n);
+  second_order_.resize(n);
+  signature_.resize(n);
 }
 
 void ImplicitStep::reserve(std::size_t couplings) {
@@ -139,6 +144,7 @@ void ImplicitStep::reserve(std::size_t couplings) {
   slide_.reserve(couplings);
   solved_.reserve(couplings);
   u0_.reserve(couplings);
+  start_force_.reserve(couplings);
   current_couplings_.reserve(couplings);
 }
 
@@ -161,7 +167,7 @@ void ImplicitStep::solve(const Model& model, const State& state, const std::vect
                          const std::vector<Vec3>& w0, const std::vector<Vec3>& force,
                          const std::vector<Vec3>& torque, const std::vector<std::uint8_t>& axis_active,
                          const std::vector<Vec3>& axis, const std::vector<Vec3>& axis_point,
-                         const std::vector<double>& axis_rate, double h) {
+                         const std::vector<double>& axis_rate, const StepHistory& history, double h) {
   const int nb = static_cast<int>(model.bodies.size());
   mode_.assign(couplings.size(), CouplingMode::kHold);
   slide_.assign(couplings.size(), Vec3::Zero());
@@ -171,8 +177,11 @@ void ImplicitStep::solve(const Model& model, const State& state, const std::vect
     island_of_[b] = awake[b] ? 0 : -1;
     v1_[b] = v0[b];
     w1_[b] = w0[b];
+    second_order_[b] = 0;
+    signature_[b] = 0;
   }
   u0_.resize(couplings.size());
+  start_force_.resize(couplings.size());
   for (std::size_t i = 0; i < couplings.size(); ++i) u0_[i] = relative_velocity(state, couplings[i], v0, w0);
   // Islands: awake bodies joined by a body point (a sleeping body stays put, as the world does).
   for (const Coupling& c : couplings) {
@@ -196,43 +205,128 @@ void ImplicitStep::solve(const Model& model, const State& state, const std::vect
       const int body = (c.b >= 0 && awake[c.b]) ? c.b : c.a;
       if (body >= 0 && awake[body] && find(body) == root) current_couplings_.push_back(static_cast<int>(i));
     }
-    // Rounds: solve, then change modes where the solution breaks a limit. A point leaving the
-    // cone is decided before any point letting go: a held point stops the body dead, and the
-    // torque that takes can lift other points that a sliding body keeps on the floor.
-    for (int round = 0; round < kMaxRounds; ++round) {
-      assemble_and_solve(model, state, couplings, v0, w0, force, torque, axis_active, axis, axis_point, axis_rate, h);
-      bool slipped = false, released = false;
+    // BDF2 where every body of the island stepped in this same island for kSettledSteps, with no
+    // axis rule (a rule sets the rate about its axis outright, a jump the history cannot carry),
+    // no finger (its force is the fast loops' mean over the window, measured while its god-object
+    // slid on the surface: its stretch over a step is not the bodies' displacement, which is what
+    // BDF2's history term takes it to be) and the gyroscopic term neglected (its step is backward
+    // Euler's one Newton step; BDF2 on the world angular velocity would drift |L| by 21 % in
+    // spin_flip).
+    const std::uint64_t last = history.order == 2 && model.gyroscopic == Gyroscopic::kNeglect ? history.signature[root] : 0;
+    bool bdf2 = last != 0;
+    // Nor a point between two bodies: those are found only once they overlap (the floor's are
+    // taken in as the step reaches them), and BDF2's lighter damping of an arrival's bounce lets a
+    // body overshoot such a point by a micrometre, lose it and fall a whole step back in.
+    for (int i : current_couplings_) bdf2 = bdf2 && couplings[i].source == Coupling::Source::kFloor;
+    for (int b : current_) {
+      bdf2 = bdf2 && history.valid[b] && !axis_active[b] && history.signature[b] == last &&
+             history.steps[b] >= kSettledSteps;
+    }
+    if (bdf2) {
+      const double third = 1.0 / 3.0;
+      for (int b : current_) {
+        vq_[b] = third * (4.0 * v0[b] - state.bodies[b].velocity_before_step);
+        wq_[b] = third * (4.0 * w0[b] - state.bodies[b].angular_velocity_before_step);
+      }
+      // The springs' displacement over the step is h (u_mean + 2 u1) / 3: the part already known
+      // joins the force at the start (in a sliding point only its normal part counts).
       for (int i : current_couplings_) {
         const Coupling& c = couplings[i];
-        const Vec3 u1 = relative_velocity(state, c, v1_, w1_);
-        solved_[i] = constant_force(c, mode_[i], u0_[i], slide_[i]) - response(c, mode_[i], slide_[i], h) * u1;
-        if (c.mu < 0.0 || mode_[i] != CouplingMode::kHold) continue;
-        const double f_n = c.normal.dot(solved_[i]);
-        const Vec3 f_t = solved_[i] - f_n * c.normal;
-        const double f_t_norm = f_t.norm();
-        // Out of the cone (or pulling, which no cone holds): it slides the way it pulled. A
-        // pulling point slides before it may let go, so that a held point's drag, which pitches
-        // the body, is gone before the solve decides which points lift off.
-        if (f_t_norm > c.mu * std::max(0.0, f_n) + c.viscous) {
-          mode_[i] = CouplingMode::kSlip;
-          slide_[i] = f_t / f_t_norm;
-          slipped = true;
-        }
+        const Vec3 u = relative_velocity(state, c, history.v_mean, history.w_mean);
+        const double u_n = c.normal.dot(u);
+        start_force_[i] = c.force - (third * h) * (c.k_n * u_n * c.normal + c.k_t * (u - u_n * c.normal));
       }
-      if (!slipped) {
-        for (int i : current_couplings_) {
-          const Coupling& c = couplings[i];
-          if (c.mu < 0.0 || mode_[i] == CouplingMode::kOff || c.normal.dot(solved_[i]) >= 0.0) continue;
-          mode_[i] = CouplingMode::kOff;   // it would pull: the point lets go
-          released = true;
-        }
-      }
-      if (!slipped && !released) break;
+      solve_island(model, state, couplings, force, torque, axis_active, axis, axis_point, axis_rate, 2.0 * third * h);
+      bdf2 = island_signature(couplings) == last;
     }
-    for (int i : current_couplings_) {
-      if (mode_[i] == CouplingMode::kOff) solved_[i].setZero();
+    if (!bdf2) {
+      for (int b : current_) {
+        vq_[b] = v0[b];
+        wq_[b] = w0[b];
+      }
+      for (int i : current_couplings_) start_force_[i] = couplings[i].force;
+      solve_island(model, state, couplings, force, torque, axis_active, axis, axis_point, axis_rate, h);
+    }
+    const std::uint64_t signature = island_signature(couplings);
+    for (int b : current_) {
+      second_order_[b] = bdf2 ? 1 : 0;
+      signature_[b] = signature;
     }
   }
+}
+
+// Rounds: solve, then change modes where the solution breaks a limit. A point leaving the cone is
+// decided before any point letting go: a held point stops the body dead, and the torque that takes
+// can lift other points that a sliding body keeps on the floor. `h` is the step's implicit
+// coefficient: the step for backward Euler, 2/3 of it for BDF2.
+void ImplicitStep::solve_island(const Model& model, const State& state, const std::vector<Coupling>& couplings,
+                                const std::vector<Vec3>& force, const std::vector<Vec3>& torque,
+                                const std::vector<std::uint8_t>& axis_active, const std::vector<Vec3>& axis,
+                                const std::vector<Vec3>& axis_point, const std::vector<double>& axis_rate,
+                                double h) {
+  for (int i : current_couplings_) {
+    mode_[i] = CouplingMode::kHold;
+    slide_[i].setZero();
+    solved_[i].setZero();
+  }
+  for (int round = 0; round < kMaxRounds; ++round) {
+    assemble_and_solve(model, state, couplings, vq_, wq_, force, torque, axis_active, axis, axis_point, axis_rate, h);
+    bool slipped = false, released = false;
+    for (int i : current_couplings_) {
+      const Coupling& c = couplings[i];
+      const Vec3 u1 = relative_velocity(state, c, v1_, w1_);
+      solved_[i] = constant_force(c, start_force_[i], mode_[i], u0_[i], slide_[i]) - response(c, mode_[i], slide_[i], h) * u1;
+      if (c.mu < 0.0 || mode_[i] != CouplingMode::kHold) continue;
+      const double f_n = c.normal.dot(solved_[i]);
+      const Vec3 f_t = solved_[i] - f_n * c.normal;
+      const double f_t_norm = f_t.norm();
+      // Out of the cone (or pulling, which no cone holds): it slides the way it pulled. A
+      // pulling point slides before it may let go, so that a held point's drag, which pitches
+      // the body, is gone before the solve decides which points lift off.
+      if (f_t_norm > c.mu * std::max(0.0, f_n) + c.viscous) {
+        mode_[i] = CouplingMode::kSlip;
+        slide_[i] = f_t / f_t_norm;
+        slipped = true;
+      }
+    }
+    if (!slipped) {
+      for (int i : current_couplings_) {
+        const Coupling& c = couplings[i];
+        if (c.mu < 0.0 || mode_[i] == CouplingMode::kOff || c.normal.dot(solved_[i]) >= 0.0) continue;
+        mode_[i] = CouplingMode::kOff;   // it would pull: the point lets go
+        released = true;
+      }
+    }
+    if (!slipped && !released) break;
+  }
+  for (int i : current_couplings_) {
+    if (mode_[i] == CouplingMode::kOff) solved_[i].setZero();
+  }
+}
+
+// FNV-1a over the island's bodies and its couplings' identities, whether each pushed at the start
+// of the step, and their modes: equal from one step to the next only while the same points act on
+// the same bodies in the same way. (A floor point the step reaches is a coupling before the body
+// arrives; its arrival is the step its force starts to push.)
+std::uint64_t ImplicitStep::island_signature(const std::vector<Coupling>& couplings) const {
+  std::uint64_t hash = 14695981039346656037ull;
+  const auto mix = [&hash](std::int64_t value) {
+    for (int byte = 0; byte < 8; ++byte) {
+      hash ^= static_cast<std::uint64_t>(value >> (8 * byte)) & 0xffu;
+      hash *= 1099511628211ull;
+    }
+  };
+  for (int b : current_) mix(b);
+  for (int i : current_couplings_) {
+    const Coupling& c = couplings[i];
+    mix(static_cast<std::int64_t>(c.source));
+    mix(c.slot);
+    mix(c.a);
+    mix(c.b);
+    mix(c.normal.dot(c.force) > 0.0 ? 1 : 0);
+    mix(static_cast<std::int64_t>(mode_[i]));
+  }
+  return hash == 0 ? 1 : hash;   // 0 means no history
 }
 
 void ImplicitStep::assemble_and_solve(const Model& model, const State& state,
@@ -267,7 +361,7 @@ void ImplicitStep::assemble_and_solve(const Model& model, const State& state,
     const Coupling& c = couplings[i];
     if (mode_[i] == CouplingMode::kOff) continue;
     const Response g = response_shape(c, mode_[i], slide_[i], h);
-    Vec3 fc = constant_force(c, mode_[i], u0_[i], slide_[i]);
+    Vec3 fc = constant_force(c, start_force_[i], mode_[i], u0_[i], slide_[i]);
     if (c.a < 0) fc += g.full * c.world_velocity;   // the world side moves on: u1 = J q1 - v_world
     const bool in_b = c.b >= 0 && island_of_[c.b] >= 0;
     const bool in_a = c.a >= 0 && island_of_[c.a] >= 0;

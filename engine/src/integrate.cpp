@@ -136,4 +136,16 @@ void move_body(const BodyParams& params, BodyState& body, const Vec3& force, con
   orthonormalize(body.rotation);
 }
 
+void move_body_bdf2(BodyState& body, const Vec3& v1, const Vec3& w1, const Vec3& v_mean, const Vec3& w_mean,
+                    double dt) {
+  const double third = dt / 3.0;   // s
+  body.velocity = v1;
+  body.angular_velocity = w1;
+  body.position += third * (v_mean + 2.0 * v1);
+  const Vec3 turn = third * (w_mean + 2.0 * w1);   // rad, world: the rotation vector of the step
+  const double angle = turn.norm();
+  if (angle > 0.0) body.rotation = Eigen::AngleAxisd(angle, turn / angle).toRotationMatrix() * body.rotation;
+  orthonormalize(body.rotation);
+}
+
 }  // namespace graspsim

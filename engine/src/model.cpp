@@ -183,6 +183,8 @@ void validate(const Model& model) {
   if (r.servo % r.physics != 0)
     fail("rates.physics", std::to_string(r.physics) + " Hz does not divide rates.servo = " + std::to_string(r.servo) + " Hz");
   if (!finite(model.gravity)) fail("gravity", "must be finite");
+  if (model.implicit_order != 1 && model.implicit_order != 2)
+    fail("implicit_order", "must be 1 (backward Euler) or 2 (BDF2) (got " + std::to_string(model.implicit_order) + ")");
   const SleepParams& sl = model.sleep;
   if (!(sl.linear_speed >= 0.0) || std::isinf(sl.linear_speed))
     fail("sleep.linear_speed", "must be >= 0 m/s and finite (got " + str(sl.linear_speed) + ")");

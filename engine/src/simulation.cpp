@@ -60,6 +60,12 @@ Simulation::Simulation(Model model)
   w0_.resize(n);
   external_force_.resize(n);
   external_torque_.resize(n);
+  history_.order = model_.implicit_order;
+  history_.valid.resize(n);
+  history_.v_mean.resize(n);
+  history_.w_mean.resize(n);
+  history_.signature.resize(n);
+  history_.steps.resize(n);
   finger_point_.resize(model_.fingers.size());
   finger_force_.resize(model_.fingers.size());
 }

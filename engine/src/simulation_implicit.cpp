@@ -91,6 +91,15 @@ void Simulation::implicit_solve(double pitch_change) {
     w0_[b] = bs.angular_velocity + gyroscopic_change(bp, model_.gyroscopic, bs, h);
     external_force_[b] = bs.window_force * per_tick + bp.mass * model_.gravity;
     external_torque_[b] = bs.window_torque * per_tick;
+    // The last step's displacement rates, for BDF2, from a body stepped at the last physics tick.
+    history_.valid[b] = !bs.asleep && bs.stepped_at >= 0 && bs.stepped_at + divisors_.physics == state_.tick;
+    history_.signature[b] = bs.island_signature;
+    history_.steps[b] = bs.island_steps;
+    if (history_.valid[b]) {
+      history_.v_mean[b] = (bs.position - bs.position_before_step) / h;
+      const Eigen::AngleAxisd turn(bs.rotation * bs.rotation_before_step.transpose());
+      history_.w_mean[b] = (turn.angle() / h) * turn.axis();
+    }
   }
   // The fingers' forces enter through their couplings: what is left of the bodies' windows is
   // what fingers pushed that are no longer in contact, and the torque of each finger's force
@@ -121,7 +130,7 @@ void Simulation::implicit_solve(double pitch_change) {
     axis_rate_[b] = rules_[b].rate;
   }
   implicit_.solve(model_, state_, couplings_, awake_, v0_, w0_, external_force_, external_torque_, axis_active_,
-                  axis_, axis_point_, axis_rate_, h);
+                  axis_, axis_point_, axis_rate_, history_, h);
 
   std::fill(floor_points_.begin(), floor_points_.end(), 0);
   const int n = static_cast<int>(nb);
@@ -162,12 +171,25 @@ void Simulation::implicit_body_step(int b, TickRecord& record) {
   const Mat3& R = bs.rotation;
   const Vec3 force = (bp.mass / h) * (implicit_.velocity(b) - v0_[b]);
   Vec3 torque = (R * bp.inertia.asDiagonal() * R.transpose()) * ((implicit_.angular_velocity(b) - w0) / h);
-  bs.angular_velocity = w0;
   rec.force = force;
   rec.torque = torque;
-  mark_stepped(bs);
-  move_body(bp, bs, force, torque, h);
-  turn_about_axis(rule.grasp, rule.turn, bs);
+  const Vec3 v_start = bs.velocity, w_start = bs.angular_velocity;
+  if (implicit_.second_order(b)) {
+    const Vec3 v_mean = history_.v_mean[b], w_mean = history_.w_mean[b];
+    mark_stepped(bs);
+    move_body_bdf2(bs, implicit_.velocity(b), implicit_.angular_velocity(b), v_mean, w_mean, h);
+  } else {
+    bs.angular_velocity = w0;
+    mark_stepped(bs);
+    move_body(bp, bs, force, torque, h);
+    turn_about_axis(rule.grasp, rule.turn, bs);
+  }
+  if (model_.implicit_order == 2) {
+    bs.velocity_before_step = v_start;
+    bs.angular_velocity_before_step = w_start;
+    bs.island_steps = implicit_.signature(b) == bs.island_signature ? bs.island_steps + 1 : 1;
+    bs.island_signature = implicit_.signature(b);
+  }
   finish_body_step(b, record);
 }
 

@@ -12,9 +12,31 @@
 namespace graspsim {
 
 Eigen::MatrixXd one_step_map(Integrator integrator, const Eigen::MatrixXd& k, const Eigen::MatrixXd& c,
-                             double h) {
+                             double h, int implicit_order) {
   const Eigen::Index n = k.rows();
   const Eigen::MatrixXd id = Eigen::MatrixXd::Identity(n, n);
+  if (integrator == Integrator::kImplicit && implicit_order == 2) {
+    // BDF2 on (z, y), with y = h z' (state: z0, y0, z_-1, y_-1):
+    //   S2 y1 = (4 y0 - y_-1) / 3 - (2/3) h^2 K' (4 z0 - z_-1) / 3,  S2 = I + (2/3) h C' + (4/9) h^2 K'
+    //   z1 = (4 z0 - z_-1) / 3 + (2/3) y1
+    const Eigen::LLT<Eigen::MatrixXd> s(id + (2.0 / 3.0) * h * c + (4.0 / 9.0) * h * h * k);
+    const Eigen::MatrixXd s_inv = s.solve(id);
+    const Eigen::MatrixXd s_inv_z = s.solve((2.0 / 3.0) * h * h * k);
+    Eigen::MatrixXd a = Eigen::MatrixXd::Zero(4 * n, 4 * n);
+    const Eigen::MatrixXd y_z0 = -(4.0 / 3.0) * s_inv_z, y_zm = (1.0 / 3.0) * s_inv_z;   // y1's rows
+    const Eigen::MatrixXd y_y0 = (4.0 / 3.0) * s_inv, y_ym = -(1.0 / 3.0) * s_inv;
+    a.block(0, 0, n, n) = (4.0 / 3.0) * id + (2.0 / 3.0) * y_z0;
+    a.block(0, n, n, n) = (2.0 / 3.0) * y_y0;
+    a.block(0, 2 * n, n, n) = -(1.0 / 3.0) * id + (2.0 / 3.0) * y_zm;
+    a.block(0, 3 * n, n, n) = (2.0 / 3.0) * y_ym;
+    a.block(n, 0, n, n) = y_z0;
+    a.block(n, n, n, n) = y_y0;
+    a.block(n, 2 * n, n, n) = y_zm;
+    a.block(n, 3 * n, n, n) = y_ym;
+    a.block(2 * n, 0, n, n) = id;   // z0 and y0 become the history
+    a.block(3 * n, n, n, n) = id;
+    return a;
+  }
   const Eigen::MatrixXd z = h * h * k;   // h^2 K' (1)
   Eigen::MatrixXd a(2 * n, 2 * n);
   if (integrator == Integrator::kPaper) {

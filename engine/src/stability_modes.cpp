@@ -91,7 +91,7 @@ std::complex<double> hinge_eigenvalue(const GroupSystem::Hinge& m, Integrator in
   }
   const MatrixXd k = MatrixXd::Constant(1, 1, m.k / m.inertia);
   const MatrixXd c = MatrixXd::Constant(1, 1, m.c / m.inertia);
-  const Eigen::EigenSolver<MatrixXd> solver(one_step_map(integrator, k, c, h), false);
+  const Eigen::EigenSolver<MatrixXd> solver(one_step_map(integrator, k, c, h, 1), false);
   std::complex<double> best = 0.0;
   for (Eigen::Index i = 0; i < solver.eigenvalues().size(); ++i) {
     if (std::abs(solver.eigenvalues()[i]) > std::abs(best)) best = solver.eigenvalues()[i];
@@ -99,8 +99,14 @@ std::complex<double> hinge_eigenvalue(const GroupSystem::Hinge& m, Integrator in
   return best;
 }
 
-double group_radius(const GroupSystem& g, Integrator integrator, double c_t, double h) {
-  double r = spectral_radius(one_step_map(integrator, g.k, g.c, h));
+// The order of the implicit step a group takes: BDF2 under implicit_order 2 but where a grasp
+// rule's hinge acts, which takes backward Euler (implicit_step.hpp).
+int group_order(const GroupSystem& g, const Model& model) {
+  return g.hinge_modes.empty() ? model.implicit_order : 1;
+}
+
+double group_radius(const GroupSystem& g, Integrator integrator, int order, double c_t, double h) {
+  double r = spectral_radius(one_step_map(integrator, g.k, g.c, h, order));
   for (const auto& m : g.hinge_modes) r = std::max(r, std::abs(hinge_eigenvalue(m, integrator, c_t, h)));
   return r;
 }
@@ -305,7 +311,7 @@ void dominant_mode(const Model& model, const State& state, const GroupSystem& g,
                    const std::vector<StabilityCoupling>& cs, const std::vector<std::string>& names,
                    Integrator integrator, double h, StabilityMode& mode) {
   const Eigen::Index d = g.k.rows();
-  const Eigen::EigenSolver<MatrixXd> solver(one_step_map(integrator, g.k, g.c, h), true);
+  const Eigen::EigenSolver<MatrixXd> solver(one_step_map(integrator, g.k, g.c, h, group_order(g, model)), true);
   Eigen::Index top = 0;
   for (Eigen::Index i = 1; i < solver.eigenvalues().size(); ++i) {
     if (std::abs(solver.eigenvalues()[i]) > std::abs(solver.eigenvalues()[top])) top = i;
@@ -357,7 +363,8 @@ int lowest_stable_rate(const GroupSystem& g, const Model& model, Integrator inte
     if (model.rates.servo % r == 0) rates.push_back(r);
   }
   const double c_t = model.grasp.torsional_damping;
-  const auto stable = [&](int rate) { return group_radius(g, integrator, c_t, 1.0 / rate) <= kUnstableRadius; };
+  const int order = group_order(g, model);
+  const auto stable = [&](int rate) { return group_radius(g, integrator, order, c_t, 1.0 / rate) <= kUnstableRadius; };
   if (rates.empty() || !stable(rates.back())) return 0;
   if (stable(rates.front())) return rates.front();
   std::size_t lo = 0, hi = rates.size() - 1;   // rates[lo] unstable, rates[hi] stable

@@ -11,7 +11,7 @@ namespace {
 // tests/engine/test_state_hash.cpp): these sizes trip when the layout changes.
 #if defined(__x86_64__) && defined(__GNUC__)
 static_assert(sizeof(State) == 80, "State changed: update state_hash and its test");
-static_assert(sizeof(BodyState) == 328, "BodyState changed: update state_hash and its test");
+static_assert(sizeof(BodyState) == 392, "BodyState changed: update state_hash and its test");
 static_assert(sizeof(VertexContact) == 56, "VertexContact changed: update state_hash and its test");
 static_assert(sizeof(FingerState) == 240, "FingerState changed: update state_hash and its test");
 static_assert(sizeof(Features) == 16, "Features changed: update state_hash and its test");
@@ -82,6 +82,13 @@ std::uint64_t state_hash(const State& s) {
     }
     h.vec(b.window_force);
     h.vec(b.window_torque);
+    // The second-order history, only when there is one: the paper's step keeps its hashes.
+    if (b.island_signature != 0) {
+      h.vec(b.velocity_before_step);
+      h.vec(b.angular_velocity_before_step);
+      h.integer(static_cast<std::int64_t>(b.island_signature));
+      h.integer(b.island_steps);
+    }
     // Sleep, only when not at its defaults: a run without sleep keeps its hashes (and goldens).
     if (b.asleep || b.still_steps != 0) {
       h.flag(b.asleep);

@@ -3,10 +3,32 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <string>
 
 namespace graspsim::hw {
+
+Vec3 clamp_force(const Vec3& force, const DeviceLimits& limits) {
+  const double limit = limits.max_force;
+  if (!force.allFinite() || !(limit > 0.0)) return Vec3::Zero();   // a fault renders nothing
+  if (std::isinf(limit)) return force;
+  // Work on force / s with s its largest component: |u| lies in [1, sqrt 3], so no square
+  // overflows (forces up to DBL_MAX) or underflows (limits down to the smallest doubles).
+  const double s = force.cwiseAbs().maxCoeff();
+  if (s == 0.0) return force;
+  const Vec3 u = force / s;
+  const double u_norm = u.norm();
+  if (s <= limit / u_norm && force.norm() <= limit) return force;   // within: unchanged
+  // Along the same direction, 4 ulp short of the limit, so that no way of computing the norm
+  // (any summation order, with or without extended precision) finds it above the limit.
+  constexpr double kShrink = 1.0 - 4.0 * std::numeric_limits<double>::epsilon();
+  return u * (limit / u_norm * kShrink);
+}
+
+double ramp_fraction(double elapsed, double rise_time) {
+  return rise_time > 0.0 ? std::clamp(elapsed / rise_time, 0.0, 1.0) : 1.0;
+}
 
 namespace {
 void require(bool ok, const char* field, double value, const char* rule) {
@@ -33,9 +55,7 @@ ForceSafety::ForceSafety(const ForceSafetyConfig& c) : config_(c) {
 double ForceSafety::limit_now(double time) const {
   const double p = config_.peak_force;
   const double c = config_.continuous_force;
-  double ramp = p;
-  if (config_.rise_time > 0.0)
-    ramp = p * std::clamp((time - start_time_) / config_.rise_time, 0.0, 1.0);
+  const double ramp = p * ramp_fraction(time - start_time_, config_.rise_time);
   const double therm_sq = std::max(0.0, p * p - (p * p - c * c) * (heat_ / (c * c)));
   return std::min(ramp, std::sqrt(therm_sq));
 }

@@ -2,6 +2,7 @@
 #include "graspsim/hw/mapped_device.hpp"
 
 #include <cmath>
+#include <cstdio>
 #include <sstream>
 #include <stdexcept>
 
@@ -48,6 +49,15 @@ std::string MappedDevice::describe() const {
     << mapping_.offset.y() << "," << mapping_.offset.z() << " m, rotation " << mapping_.rotation.x() << ","
     << mapping_.rotation.y() << "," << mapping_.rotation.z() << " rad)";
   return s.str();
+}
+
+// Every digit (%.17g), so a replay parses back the very mapping the run used.
+std::string MappedDevice::mapping_text() const {
+  const WorkspaceMapping& m = mapping_;
+  char buf[256];
+  std::snprintf(buf, sizeof buf, "scale %.17g; offset %.17g %.17g %.17g m; rotation %.17g %.17g %.17g rad", m.scale,
+                m.offset.x(), m.offset.y(), m.offset.z(), m.rotation.x(), m.rotation.y(), m.rotation.z());
+  return buf;
 }
 
 namespace {

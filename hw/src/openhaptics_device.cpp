@@ -402,6 +402,7 @@ class PhantomDevice final : public OpenHapticsDevice {
   std::string config_name() const override { return slot_->opened; }
   double rate() const override { return slot_->rate; }
   // s: the last read sample's servo frame on the device clock, k / rate.
+  bool has_sample_clock() const override { return true; }
   double sample_time() const override { return static_cast<double>(frame_) / slot_->rate; }
   std::int64_t sample_sequence() const override { return frame_; }   // its servo frame k
   std::int64_t new_samples() const override { return new_frames_; }  // frames since the read before

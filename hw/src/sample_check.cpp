@@ -24,12 +24,13 @@ std::string box(const Workspace& w) {
 
 SampleCheck::SampleCheck(const Device& device, std::string finger)
     : device_(device),
-      mapped_(dynamic_cast<const MappedDevice*>(&device)),
+      mapped_(device.device_frame_sample() != nullptr),
       workspace_(device.workspace()),
       finger_(std::move(finger)) {}
 
 void SampleCheck::check(const DeviceSample& world, std::int64_t tick, double time) const {
-  const DeviceSample& own = mapped_ ? mapped_->last_device_sample() : world;   // the device's frame
+  const DeviceSample* frame = device_.device_frame_sample();
+  const DeviceSample& own = frame ? *frame : world;   // the device's frame
   if (!own.gimbal.allFinite()) refuse(tick, time, "gimbal angles " + vec(own.gimbal) + " rad are not finite");
   if (!own.position.allFinite()) refuse(tick, time, "position " + vec(own.position) + " m is not finite");
   if (!workspace_.contains(own.position)) {

@@ -398,7 +398,7 @@ FingerParts finger(const LuaValue& value, std::size_t index) {
   }
   if (const LuaValue* device = r.get("device")) {
     // The device's default spec and workspace mapping (world = offset + scale R p); the spec's
-    // syntax is checked by the CLI's device factory, which knows the kinds (tools/app/devices.cpp).
+    // syntax is checked by the CLI's device factory, which knows the kinds (app/devices.cpp).
     const Record d(*device, r.at("device"), TableKind::kDevice);
     out.setup.device = d.string_or("default", out.setup.device);
     if (out.setup.device.empty()) fail(d.at("default"), "must not be empty (\"scripted\", \"sim-phantom\", ...)");
@@ -493,7 +493,7 @@ bool is_named_array(TableKind kind) {
 
 const std::vector<std::string>& fields_of(TableKind kind) {
   static const std::vector<std::string> kRoot = {
-      "name", "description", "duration", "seed", "rates", "gravity", "integrator", "local_model", "stability",
+      "name", "description", "duration", "seed", "rates", "gravity", "integrator", "implicit_order", "local_model", "stability",
       "gyroscopic", "grasp", "floor", "sleep", "objects", "fingers", "expect"};
   static const std::vector<std::string> kGrasp = {"torsion", "critical_area", "gimbal_finger", "dead_band",
                                                       "torsional_damping"};
@@ -622,6 +622,14 @@ ScenarioParts convert_scenario(const LuaValue& root, const std::string& default_
   if (const LuaValue* i = r.get("integrator")) {
     const std::string name = choice(*i, r.at("integrator"), {"paper", "implicit"}, "integrator");
     s.model.integrator = name == "paper" ? Integrator::kPaper : Integrator::kImplicit;
+  }
+  if (const LuaValue* order = r.get("implicit_order")) {
+    const std::int64_t value = integer(*order, r.at("implicit_order"));
+    if (value != 1 && value != 2)
+      fail(r.at("implicit_order"), "must be 1 (backward Euler) or 2 (BDF2) (got " + std::to_string(value) + ")");
+    if (s.model.integrator != Integrator::kImplicit)
+      fail(r.at("implicit_order"), "needs integrator = \"implicit\" (the paper's step has one order)");
+    s.model.implicit_order = static_cast<int>(value);
   }
   if (const LuaValue* lm = r.get("local_model")) {
     if (lm->type != LuaValue::Type::kBoolean) fail(r.at("local_model"), "expected true or false, got " + lm->type_name());

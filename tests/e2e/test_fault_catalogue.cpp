@@ -383,7 +383,7 @@ TEST_CASE("catalogue: default output names stay inside the working directory", "
 
 // ---------------------------------------------------------------------------------------------
 // kill -9 loses less than 0.25 s of simulated time, however far the writer lags. The
-// run's rule (tools/app/run.cpp): a flush every 360 servo ticks (0.12 s at 3000 Hz), and each
+// run's rule (app/run_trace.cpp): a flush every 360 servo ticks (0.12 s at 3000 Hz), and each
 // flush waits until the one before it is on disk. So at any tick n the file holds every tick up
 // to the flush before last: n - (rows on disk) < 2 x 360 = 720 ticks < 0.25 s x 3000 Hz = 750.
 // The run is forked from this test and killed with SIGKILL by its own thumb device when that is
@@ -440,7 +440,7 @@ TEST_CASE("catalogue: kill -9 loses under 0.25 s of simulated time however far t
         g_pwrite_delay_ms.store(delay);
         app::RunOptions options;
         options.out = out;
-        options.make_device = [&](std::size_t f) -> std::unique_ptr<hw::Device> {
+        options.devices.make = [&](std::size_t f) -> std::unique_ptr<hw::Device> {
           auto finger = std::make_unique<hw::ScriptedFinger>(scenario.make_trajectory(f), scenario.fingers()[f].limits);
           if (f != 0) return finger;
           return std::make_unique<KillingFinger>(std::move(finger), kill_at);

@@ -1,8 +1,8 @@
-// Lua off the real-time thread (tools/app/script_thread.hpp): in a paced run Lua
+// Lua off the real-time thread (app/script_thread.hpp): in a paced run Lua
 // trajectories are sampled ahead on a script thread into rings, expectations are checked after
 // the loop, and the loop's thread may not enter Lua (the sandbox's thread guard). Paced runs use
 // a fake clock (as tests/e2e/test_pacer.cpp): no wall-clock thresholds. A fake clock lets the loop
-// outrun any thread, so the e2e runs set RunOptions::wait_for_script (the loop waits for a sample
+// outrun any thread, so the e2e runs set RunSeams::wait_for_script (the loop waits for a sample
 // the script thread can still compute); a dry ring is tested on its own, with a script thread
 // held at a gate.
 #include <catch2/catch.hpp>
@@ -87,17 +87,18 @@ struct PacedRun {
   std::int64_t forbidden_uses = 0;
 };
 
-// Runs `scenario` paced on a fake clock, its fingers scripted (run.cpp's own ScriptedFinger),
+// Runs `scenario` paced on a fake clock, its fingers scripted (the run loop's own ScriptedFinger),
 // the loop's thread forbidden to enter Lua.
 PacedRun run_paced(const scripting::Scenario& scenario, const std::string& out) {
   FakeClock clock;
   app::Pacer pacer(clock, scenario.model().rates.servo, app::kStallTimeout);
   app::RunOptions o;
   o.out = kTmp + "/" + out + ".h5";
-  o.pacer = &pacer;
-  o.wait_for_script = true;
+  o.pacing.pacer = &pacer;
+  app::RunSeams seams;
+  seams.wait_for_script = true;
   PacedRun r;
-  r.result = app::run_scenario(scenario, o);
+  r.result = app::run_scenario(scenario, o, seams);
   r.forbidden_uses = scenario.lua_uses_on_forbidden_thread();
   return r;
 }

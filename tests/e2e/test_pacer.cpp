@@ -1,4 +1,4 @@
-// The real-time pacer (tools/app/pacer.hpp) on an injected clock: no wall-clock thresholds. A tick
+// The real-time pacer (app/pacer.hpp) on an injected clock: no wall-clock thresholds. A tick
 // whose work ends after start + (n + 1) T is an overrun, one that ends more than the stall
 // timeout after the previous tick ended is a stall; an early tick sleeps to its deadline exactly. In a run, an
 // artificially slow device read is counted and flagged in /devices, and a stall releases every
@@ -169,9 +169,9 @@ TEST_CASE("A paced run counts the overrun of an artificially slow tick and recor
   std::vector<hw::Vec3> last(2, hw::Vec3::Ones());
   app::RunOptions o;
   o.out = kTmp + "/pacer_overrun.h5";
-  o.pacer = &pacer;
-  o.record_devices = {false, true};
-  o.make_device = [&](std::size_t f) -> std::unique_ptr<hw::Device> {
+  o.pacing.pacer = &pacer;
+  o.devices.record = {false, true};
+  o.devices.make = [&](std::size_t f) -> std::unique_ptr<hw::Device> {
     return std::make_unique<SlowFinger>(scenario.make_trajectory(f), clock, f == 1 ? 4500 : -1, 666'666, last[f]);
   };
   const app::RunResult r = app::run_scenario(scenario, o);
@@ -196,8 +196,8 @@ TEST_CASE("A paced run that stalls past the timeout releases every device and st
   std::vector<hw::Vec3> last(2, hw::Vec3::Ones());
   app::RunOptions o;
   o.out = kTmp + "/pacer_stall.h5";
-  o.pacer = &pacer;
-  o.make_device = [&](std::size_t f) -> std::unique_ptr<hw::Device> {
+  o.pacing.pacer = &pacer;
+  o.devices.make = [&](std::size_t f) -> std::unique_ptr<hw::Device> {
     return std::make_unique<SlowFinger>(scenario.make_trajectory(f), clock, f == 1 ? 4500 : -1, 30'000'000, last[f]);
   };
   const app::RunResult r = app::run_scenario(scenario, o);
@@ -219,9 +219,9 @@ TEST_CASE("A paced run sees Ctrl-C at the next tick and releases every device", 
   std::atomic<bool> interrupt{false};
   app::RunOptions o;
   o.out = kTmp + "/pacer_interrupt.h5";
-  o.pacer = &pacer;
-  o.interrupt = &interrupt;
-  o.make_device = [&](std::size_t f) -> std::unique_ptr<hw::Device> {
+  o.pacing.pacer = &pacer;
+  o.stop.interrupt = &interrupt;
+  o.devices.make = [&](std::size_t f) -> std::unique_ptr<hw::Device> {
     auto d = std::make_unique<SlowFinger>(scenario.make_trajectory(f), clock, -1, 0, last[f]);
     if (f == 1) d->on_tick = [&](std::int64_t n) { if (n == 4500) interrupt.store(true); };
     return d;
@@ -241,7 +241,7 @@ TEST_CASE("A device that fails to open releases the ones already open", "[e2e][s
   std::vector<hw::Vec3> last(2, hw::Vec3::Ones());
   app::RunOptions o;
   o.out = kTmp + "/device_open_fails.h5";
-  o.make_device = [&](std::size_t f) -> std::unique_ptr<hw::Device> {
+  o.devices.make = [&](std::size_t f) -> std::unique_ptr<hw::Device> {
     if (f == 1) throw std::runtime_error("phantom 'Right': HD_DEVICE_NOT_FOUND");
     return std::make_unique<SlowFinger>(scenario.make_trajectory(f), clock, -1, 0, last[f]);
   };

@@ -1,4 +1,4 @@
-// A run's memory and disk, estimated before it starts (tools/app/run_budget.hpp): the estimate
+// A run's memory and disk, estimated before it starts (app/run_budget.hpp): the estimate
 // against what a run actually writes, and the refusal when a machine cannot hold it.
 #include <catch2/catch.hpp>
 #include <hdf5.h>
@@ -61,8 +61,8 @@ std::vector<hw::Vec3> rows(const recordings::Dataset& d) {
 // its storage S holds the estimate E with at most one chunk C to spare: E <= S < E + C, per table,
 // and each table's row is the stored compound type's size exactly. Swept over three durations of
 // the lift (1.5 s, 2.34 s: a partly filled last chunk, 4 s), and with one finger on a replayed
-// device (its /devices table, 121-byte rows with the counters: run_budget.cpp's count of
-// run.cpp's columns).
+// device (its /devices table, 121-byte rows with the counters: DeviceRecorder::row_size, the
+// sum of its field tables, against the table the runner wrote through it).
 TEST_CASE("the disk estimate is every table's rows at their stored size, within one chunk of the file's "
           "storage", "[e2e][run_budget]") {
   const scripting::Scenario recorded = lift({});
@@ -78,8 +78,8 @@ TEST_CASE("the disk estimate is every table's rows at their stored size, within 
       app::RunOptions options;
       options.out = kTmp + "/budget_run.h5";
       if (device) {
-        options.record_devices = {true, false};
-        options.make_device = [&](std::size_t f) -> std::unique_ptr<hw::Device> {
+        options.devices.record = {true, false};
+        options.devices.make = [&](std::size_t f) -> std::unique_ptr<hw::Device> {
           if (f == 1) return std::make_unique<hw::ScriptedFinger>(scenario.make_trajectory(1), scenario.fingers()[1].limits);
           return std::make_unique<hw::ReplayDevice>(rows(hip), rows(gimbal), scenario.fingers()[0].limits, "recording");
         };
@@ -122,7 +122,7 @@ TEST_CASE("the memory estimate is the writer's blocks of one flush interval per 
   CHECK(base.memory == 451512.0);
   CHECK(base.servo_ticks == 12000);
   CHECK(app::estimate_footprint(lift({"rates.servo=30000", "rates.haptic=5000"}), options).memory == 4457232.0);
-  options.background_writer = false;
+  options.trace.background_writer = false;
   CHECK(app::estimate_footprint(lift({}), options).memory == 8.0 * (360 * 26 + 60 * 30 + 6 * 27) + 360 * 208 + 60 * 218 + 6 * 208);
   CHECK_THAT(base.memory_detail, Contains("/servo: 4 blocks of 360 rows of 26 values"));
 }

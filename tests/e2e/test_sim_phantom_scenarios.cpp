@@ -97,7 +97,7 @@ Outcome run_on_sim_phantom(const std::string& scenario_name, const std::string& 
   std::string device = spec;
   std::replace(device.begin(), device.end(), ':', '_');
   o.out = kTmp + "/sim_phantom_" + test + "_" + scenario_name + "_" + device + ".h5";
-  o.make_device = [&](std::size_t f) -> std::unique_ptr<hw::Device> {
+  o.devices.make = [&](std::size_t f) -> std::unique_ptr<hw::Device> {
     return std::make_unique<Watched>(app::make_device(plan, registry, scenario, f), &out.watch[f]);
   };
   out.result = app::run_scenario(scenario, o);

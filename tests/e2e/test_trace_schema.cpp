@@ -1,6 +1,8 @@
 // The schema document matches what is written: every column (a member of a table's compound
 // rows) and attribute of a real trace is in recordings/README.md's tables (same shape, dtype,
-// units, type), and everything the tables list is in the trace. Parses the README; fails when the two disagree, naming the difference.
+// units, type), and everything the tables list is in the trace; and the README's /servo,
+// /haptic and /physics columns are exactly the recorder's field tables (trace_schema.hpp).
+// Parses the README; fails when they disagree, naming the difference.
 #include <catch2/catch.hpp>
 #include <hdf5.h>
 
@@ -12,6 +14,7 @@
 #include <vector>
 
 #include "app/run.hpp"
+#include "graspsim/recordings/trace_schema.hpp"
 #include "graspsim/scripting/scenario.hpp"
 
 using namespace graspsim;
@@ -219,7 +222,7 @@ TEST_CASE("recordings/README.md documents exactly the datasets and attributes of
   app::RunOptions options;
   options.out = kTmp + "/e2e_schema.h5";
   options.overrides = load.sets;
-  options.record_devices = {false, true};   // the index finger's samples in /devices/index
+  options.devices.record = {false, true};   // the index finger's samples in /devices/index
   const app::RunResult result = app::run_scenario(scenario, options);
   REQUIRE(result.error.empty());
 
@@ -258,4 +261,46 @@ TEST_CASE("recordings/README.md documents exactly the datasets and attributes of
   CHECK(found.attributes == documented_attributes);
   // The table's schema_version is the file's.
   CHECK(documented_attributes.count({"/", "schema_version", "int64"}) == 1);
+}
+
+// The field tables TraceRecorder and DeviceRecorder declare their columns from
+// (trace_schema.hpp) are what the README documents: the same columns of /servo, /haptic,
+// /physics and /devices/<finger> with the same shape, dtype and units, and each column's note
+// (order, values, hash) in the attribute table.
+TEST_CASE("recordings/README.md documents exactly the recorders' field tables", "[e2e][trace][schema]") {
+  std::set<DatasetRow> documented;
+  std::string group;
+  for (const auto& row : table("| table | column |")) {
+    REQUIRE(row.size() >= 5);
+    if (!row[0].empty()) group = code(row[0]);
+    documented.insert({group + "/" + code(row[1]), row[2], row[3], row[4]});
+  }
+  std::set<AttributeRow> documented_notes;
+  for (const auto& row : table("| on | attribute |")) {
+    REQUIRE(row.size() >= 3);
+    const std::string on = code(row[0]);
+    // Column notes: attributes on a column path (the table attributes of /devices/<finger>,
+    // device, mapping and max_force, are the runner's).
+    if (on.rfind("/servo/", 0) == 0 || on.rfind("/haptic/", 0) == 0 || on.rfind("/physics/", 0) == 0 ||
+        (on.rfind("/devices/<finger>/", 0) == 0))
+      documented_notes.insert({on, code(row[1]), row[2]});
+  }
+
+  std::set<DatasetRow> tabled;
+  std::set<AttributeRow> tabled_notes;
+  for (const recordings::schema::ColumnDoc& c : recordings::schema::recorded_columns()) {
+    const std::string shape = c.width == 1 ? "(n)" : "(n," + std::to_string(c.width) + ")";
+    tabled.insert({c.path, shape, recordings::name_of(c.dtype), c.units});
+    if (!c.note.name.empty()) tabled_notes.insert({c.path, std::string(c.note.name), "string"});
+  }
+  // 2 + 4 + 2 + 8 + 3 + 11 + 10 columns: tick and time in each loop, the state hash, the
+  // per-finger and per-object fields, and a device's 8 fields and 2 counters.
+  CHECK(tabled.size() == 40);
+
+  INFO("in the field tables, not in the README (path | shape | dtype | units):\n" << list(minus(tabled, documented)));
+  INFO("in the README, not in the field tables:\n" << list(minus(documented, tabled)));
+  CHECK(tabled == documented);
+  INFO("notes in the field tables, not in the README (on | name | type):\n" << list(minus(tabled_notes, documented_notes)));
+  INFO("notes in the README, not in the field tables:\n" << list(minus(documented_notes, tabled_notes)));
+  CHECK(tabled_notes == documented_notes);
 }

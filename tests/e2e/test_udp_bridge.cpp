@@ -257,7 +257,7 @@ TEST_CASE("graspsim run with a finger on the UDP bridge and its replay are bit f
   CHECK(run.status == 1);
   CHECK_THAT(run.output, !Catch::Contains("pacing"));
   CHECK(graspsim::recordings::read_dataset(session, "/devices/thumb/position").shape.at(0) == 6000);
-  // The device's own numbering and clock (hw::SampleCounter, SampleClock): in lockstep the server
+  // The device's own numbering and clock (hw::Device::sample_sequence, sample_time): in lockstep the server
   // answers each datagram with the next sample, so tick n reads sample n, one new per tick, taken
   // at n / 3000 s on the server's clock (`--lockstep`: device time = k / rate).
   const auto sequence = graspsim::recordings::read_dataset(session, "/devices/thumb/sequence").values;

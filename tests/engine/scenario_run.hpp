@@ -1,6 +1,6 @@
 // A library scenario on the engine alone: loaded through scripting, its fingers fed from their
 // scripted trajectories tick by tick, with no devices, trace or expectations (those are the run
-// loop's, tools/app). For tests that need a scenario's contact set or its whole run.
+// loop's, app/). For tests that need a scenario's contact set or its whole run.
 #pragma once
 
 #include <functional>
@@ -28,7 +28,7 @@ using HipOffset = std::function<Vec3(std::size_t finger, double t)>;
 
 // Runs `scenario` on `sim` (built from its model) up to servo tick `ticks`; `after` sees the
 // simulation after every tick that ran a physics step and may stop the run by returning false.
-// Trajectories that read the view get what the run loop gives them (tools/app/run.cpp), after
+// Trajectories that read the view get what the run loop gives them (app/run_loop.cpp), after
 // each physics step.
 inline void drive(const scripting::Scenario& scenario, Simulation& sim, std::int64_t ticks,
                   const std::function<bool(const Simulation&)>& after = {}, const HipOffset& offset = {}) {

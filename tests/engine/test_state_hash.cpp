@@ -39,6 +39,9 @@ State sample_state() {
     b.position_before_step = vec();
     b.rotation_before_step = mat();
     b.stepped_at = 12300;
+    b.velocity_before_step = vec();
+    b.angular_velocity_before_step = vec();
+    b.island_signature = 0x5eed;
     b.floor_contacts.resize(2);
     for (VertexContact& c : b.floor_contacts) {
       c.active = true;
@@ -111,6 +114,10 @@ std::vector<Mutation> mutations() {
     add_vec(p + "position_before_step", [b](State& s) -> Vec3& { return s.bodies[b].position_before_step; });
     add_mat(p + "rotation_before_step", [b](State& s) -> Mat3& { return s.bodies[b].rotation_before_step; });
     add(p + "stepped_at", [b](State& s) { ++s.bodies[b].stepped_at; });
+    add_vec(p + "velocity_before_step", [b](State& s) -> Vec3& { return s.bodies[b].velocity_before_step; });
+    add_vec(p + "angular_velocity_before_step", [b](State& s) -> Vec3& { return s.bodies[b].angular_velocity_before_step; });
+    add(p + "island_signature", [b](State& s) { ++s.bodies[b].island_signature; });
+    add(p + "island_steps", [b](State& s) { ++s.bodies[b].island_steps; });
     for (int k = 0; k < 2; ++k) {
       const std::string q = p + "floor_contacts[" + std::to_string(k) + "].";
       add(q + "active", [b, k](State& s) { s.bodies[b].floor_contacts[k].active ^= true; });
@@ -186,9 +193,9 @@ TEST_CASE("changing any one field of the state changes its hash", "[state_hash]"
   const State base = sample_state();
   const std::uint64_t h0 = state_hash(base);
   const auto all = mutations();
-  // tick, 2 bodies x 56 scalars (54 + asleep, still_steps) (+ a floor point), the body count, 2 fingers x 27, the finger
+  // tick, 2 bodies x 64 scalars (54 + 8 of the BDF2 history + asleep, still_steps) (+ a floor point), the body count, 2 fingers x 27, the finger
   // count, pair count, 16 points x 8, the pair count: every field is visited.
-  REQUIRE(all.size() == 1 + 2 * 56 + 1 + 2 * 34 + 1 + 1 + 16 * 8 + 1);
+  REQUIRE(all.size() == 1 + 2 * 64 + 1 + 2 * 34 + 1 + 1 + 16 * 8 + 1);
   std::vector<std::uint64_t> seen{h0};
   for (const auto& [name, mutate] : all) {
     State s = base;

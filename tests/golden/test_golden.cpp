@@ -221,7 +221,7 @@ TEST_CASE("repeated runs in one process give bit-identical traces and attributes
     std::vector<std::string> traces;
     for (const std::size_t block_rows : {std::size_t{1024}, std::size_t{1024}, std::size_t{37}}) {
       app::RunOptions options;
-      options.block_rows = block_rows;
+      options.trace.block_rows = block_rows;
       options.out = kTmp + "/determinism_" + name + "_" + std::to_string(traces.size()) + ".h5";
       REQUIRE(app::run_scenario(scenario, options).error.empty());
       traces.push_back(options.out);

@@ -327,3 +327,21 @@ TEST_CASE("ForceSafety: the stall boundary is exact: held at the timeout, zero j
     CHECK_FALSE(safety.active());
   }
 }
+
+// The one ramp law (force_safety.hpp): r(t) = min(1, t / T_rise), 0 before the start, 1 when
+// T_rise = 0. Swept over rise times and times before, at and after the rise; compared exactly:
+// r must be t / T itself while t < T (the same double operation as the law) and exactly 1 after.
+// It can fail: a ramp that started from 1, or used (t - dt) / T, differs at some of these times.
+TEST_CASE("Force ramp: one law, r = min(1, t / T_rise)", "[hw][force_safety][law]") {
+  using graspsim::hw::ramp_fraction;
+  for (double rise : {0.1, 0.5, 2.0}) {
+    for (double t : {0.0, 0.25 * rise, 0.5 * rise, std::nextafter(rise, 0.0), rise, 1.5 * rise, 10.0}) {
+      INFO("T_rise = " << rise << " s, t = " << t << " s");
+      const double r = ramp_fraction(t, rise);
+      if (t < rise) CHECK(r == t / rise);
+      else CHECK(r == 1.0);
+    }
+  }
+  CHECK(ramp_fraction(0.0, 0.0) == 1.0);    // no ramp: full force from the start
+  CHECK(ramp_fraction(-1.0, 1.0) == 0.0);   // before the ramp's start: nothing
+}

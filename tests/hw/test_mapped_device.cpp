@@ -37,6 +37,32 @@ class FakeDevice final : public graspsim::hw::Device {
   void output(const Vec3& f) override { last_force = f; }
 };
 
+// A device with its own clock, sample numbers and recorded pacing (what a UDP or replayed device
+// says of itself through the Device interface).
+class ClockedDevice final : public graspsim::hw::Device {
+ public:
+  DeviceSample read(std::int64_t tick, double) override {
+    tick_ = tick;
+    DeviceSample s;
+    s.position = {0.01 * static_cast<double>(tick), 0.0, 0.0};
+    return s;
+  }
+  DeviceLimits limits() const override { return DeviceLimits{5.0}; }
+  std::string describe() const override { return "clocked"; }
+  bool has_sample_clock() const override { return true; }
+  double sample_time() const override { return 0.001 * static_cast<double>(tick_); }
+  std::int64_t sample_sequence() const override { return 100 + tick_; }
+  std::int64_t new_samples() const override { return 2; }
+  bool has_recorded_pacing() const override { return true; }
+  bool recorded_overrun() const override { return tick_ % 2 == 1; }
+
+ protected:
+  void output(const Vec3&) override {}
+
+ private:
+  std::int64_t tick_ = -1;
+};
+
 constexpr double kPi = 3.14159265358979323846;
 
 }  // namespace
@@ -142,4 +168,42 @@ TEST_CASE("Workspace mapping: a world trajectory seen in the device frame maps b
     CHECK((m.to_world(s.position) - reference.position(t)).norm() < 1e-15);
     CHECK(s.gimbal.y() == reference.sample(t).gimbal.y());
   }
+}
+
+// A device describes itself through the Device interface (hw/README.md): a plain device has no
+// clock, no sample numbers (-1), no recorded pacing, and the world as its frame; a mapped one
+// gives its device-frame sample, force and mapping, and passes on what the wrapped device says
+// of its clock, numbers and pacing unchanged (the /devices row of a mapped UDP device keeps the
+// server's clock). Exact: nothing is computed on the way, only passed on.
+TEST_CASE("A device describes itself, and a mapped device passes on what the wrapped one says",
+          "[hw][mapping][describe]") {
+  FakeDevice plain;
+  CHECK_FALSE(plain.has_sample_clock());
+  CHECK(plain.sample_sequence() == -1);
+  CHECK(plain.new_samples() == -1);
+  CHECK_FALSE(plain.has_recorded_pacing());
+  CHECK(plain.device_frame_sample() == nullptr);
+  CHECK(plain.device_frame_force() == nullptr);
+  CHECK(plain.mapping_text() == "identity (device frame = world)");
+
+  WorkspaceMapping m;
+  m.scale = 2.0;
+  m.offset = {0.5, 0.0, 0.0};
+  MappedDevice d(std::make_unique<ClockedDevice>(), m);
+  for (std::int64_t tick : {0, 1, 7}) {
+    const DeviceSample world = d.read(tick, 0.0);
+    REQUIRE(d.device_frame_sample() != nullptr);
+    CHECK(d.device_frame_sample()->position.x() == 0.01 * static_cast<double>(tick));   // before the mapping
+    CHECK(world.position.x() == 0.5 + 2.0 * (0.01 * static_cast<double>(tick)));
+    CHECK(d.has_sample_clock());
+    CHECK(d.sample_time() == 0.001 * static_cast<double>(tick));
+    CHECK(d.sample_sequence() == 100 + tick);
+    CHECK(d.new_samples() == 2);
+    CHECK(d.has_recorded_pacing());
+    CHECK(d.recorded_overrun() == (tick % 2 == 1));
+  }
+  d.render(Vec3(1.0, 0.0, 0.0));
+  REQUIRE(d.device_frame_force() != nullptr);
+  CHECK(*d.device_frame_force() == Vec3(1.0, 0.0, 0.0));   // no rotation: the same force
+  CHECK(d.mapping_text() == "scale 2; offset 0.5 0 0 m; rotation 0 0 0 rad");
 }

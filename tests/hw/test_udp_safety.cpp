@@ -1,5 +1,5 @@
 // UdpDevice as a real device (hw/README.md, "UDP protocol"): its own clock and sample numbering for
-// the trace (hw::SampleClock, hw::SampleCounter), and the device's force limits (peak, thermal
+// the trace (hw::Device::sample_time, sample_sequence, new_samples), and the device's force limits (peak, thermal
 // continuous limit, ramp, release) applied to what it sends (hw/README.md "Force safety").
 // Every case runs on loopback against the in-process peer in lockstep, with graspsim's time
 // injected through read(tick, time): no wall clock decides anything.

@@ -71,7 +71,7 @@ TEST_CASE("a trace whose writing fails keeps exactly the rows of its last flush"
   }
 }
 
-// The runner's flush rule (tools/app/run.cpp): before it hands over flush k it waits for flush
+// The runner's flush rule (app/run_trace.cpp): before it hands over flush k it waits for flush
 // k - 1, so the file is never more than one flush interval behind the rows handed over. Here
 // the writer thread is slowed by a thread that holds the HDF5 lock for `stall` ms at a time (a
 // disk that stalls); whatever the stall, after wait(ticket of flush k - 1) returns, a reader sees

@@ -391,7 +391,7 @@ TEST_CASE("the recorder refuses unusable names and mismatched records", "[trace_
   writer.close("complete");
 }
 
-// row_sizes, which the run's memory and disk estimate uses (tools/app/run_budget.cpp), is the
+// row_sizes, which the run's memory and disk estimate uses (app/run_budget.cpp), is the
 // rows the constructor declares: for 1 to 3 fingers and 0 to 3 bodies, each table's doubles per
 // row equal TraceTable::row_width() and its bytes per row the stored compound type's size.
 TEST_CASE("row_sizes counts the doubles and bytes of every row the recorder declares", "[trace_recorder]") {

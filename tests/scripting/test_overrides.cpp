@@ -118,7 +118,7 @@ TEST_CASE("param() rejects a --set of another type than its default, naming the 
         path + ": --set lfit=0.1: unknown field or param 'lfit' (did you mean 'lift'?)");
   CHECK(error_with("params.lua", {"zzz=0.1"}) ==
         path + ": --set zzz=0.1: unknown field or param 'zzz' (known fields: name, description, "
-               "duration, seed, rates, gravity, integrator, local_model, stability, gyroscopic, grasp, floor, sleep, objects, "
+               "duration, seed, rates, gravity, integrator, implicit_order, local_model, stability, gyroscopic, grasp, floor, sleep, objects, "
                "fingers, expect; params: label, lift, start, use_floor)");
 }
 
@@ -133,7 +133,7 @@ TEST_CASE("a --set path that is not in the table nor in the format is an error w
         path + ": --set fingers.pinky.stiffness=1: no finger named 'pinky' (fingers: thumb, index)");
   CHECK(error_with("valid.lua", {"lift=0.1"}) ==   // not a param of this file, not a field
         path + ": --set lift=0.1: unknown field 'lift' (known fields: name, description, duration, "
-               "seed, rates, gravity, integrator, local_model, stability, gyroscopic, grasp, floor, sleep, objects, fingers, expect)");
+               "seed, rates, gravity, integrator, implicit_order, local_model, stability, gyroscopic, grasp, floor, sleep, objects, fingers, expect)");
   CHECK(error_with("valid.lua", {"duration.x=1"}) ==
         path + ": --set duration.x=1: 'duration' is a number, not a table");
   CHECK(error_with("valid.lua", {"fingers.index.trajectory.9.t=1"}) ==

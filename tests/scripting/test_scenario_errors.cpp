@@ -182,6 +182,15 @@ TEST_CASE("bad gyroscopic, grasp and friction values are named with their field"
   CHECK_THAT(message({"fingers.thumb.radius=-0.01"}), Catch::Contains("radius"));
 }
 
+// implicit_order is 1 or 2, and only with the implicit step (the paper's has one order).
+TEST_CASE("a bad implicit_order names its field and the choices", "[scenario][errors]") {
+  CHECK(message({"implicit_order=1"}) == "no error");
+  CHECK(message({"implicit_order=2"}) == "no error");
+  CHECK_THAT(message({"implicit_order=3"}), Catch::Contains("implicit_order") && Catch::Contains("must be 1 (backward Euler) or 2 (BDF2)"));
+  CHECK_THAT(message({"implicit_order=1.5"}), Catch::Contains("implicit_order"));
+  CHECK_THAT(message({"integrator=paper", "implicit_order=2"}), Catch::Contains("implicit_order") && Catch::Contains("needs integrator = \"implicit\""));
+}
+
 // Bad sleep values name their field.
 TEST_CASE("bad sleep values are named with their field", "[scenario][errors]") {
   CHECK_THAT(message({"sleep.time=0"}), Catch::Contains("sleep.time") && Catch::Contains("> 0 s"));

@@ -39,7 +39,7 @@ int main(int argc, char** argv) {
       const auto scenario = scripting::Scenario::load(path, load);
       app::RunOptions options;
       options.out = out;
-      options.write_trace = c.trace;
+      options.trace.write = c.trace;
       const app::RunResult result = app::run_scenario(scenario, options);
       if (!result.error.empty()) {
         std::fprintf(stderr, "bench: %s\n", result.error.c_str());

@@ -184,9 +184,9 @@ Outcome run(const std::string& scenario_path, const Perturbation& p, const std::
   app::RunOptions options;
   options.out = trace;
   options.overrides = p.sets;
-  options.record_devices = plan.recorded();
-  options.script_alongside = plan.script_alongside;
-  options.make_device = [&](std::size_t f) { return app::make_device(plan, registry, scenario, f); };
+  options.devices.record = plan.recorded();
+  options.devices.script_alongside = plan.script_alongside;
+  options.devices.make = [&](std::size_t f) { return app::make_device(plan, registry, scenario, f); };
   const app::RunResult result = app::run_scenario(scenario, options);
 
   Outcome out;

@@ -82,9 +82,9 @@ int main(int argc, char** argv) {
       app::RunOptions options;
       options.out = out;
       std::remove(out.c_str());   // see below: a truncated file costs ext4 a flush on close
-      options.write_trace = v.trace;
-      options.compression = v.compression;
-      options.background_writer = v.background;
+      options.trace.write = v.trace;
+      options.trace.compression = v.compression;
+      options.trace.background_writer = v.background;
       const double wall0 = wall_seconds();
       const double thread0 = cpu_seconds(CLOCK_THREAD_CPUTIME_ID);
       const double cpu0 = cpu_seconds(CLOCK_PROCESS_CPUTIME_ID);

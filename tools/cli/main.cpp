@@ -293,37 +293,36 @@ int run_command(const std::vector<std::string>& args) {
   graspsim::app::RunOptions options;
   options.out = out;
   options.inputs = plan.files;
-  options.compression = compression;
+  options.trace.compression = compression;
   options.overrides = load.sets;
-  options.interrupt = &g_interrupt;
-  options.interrupt_signal = &g_signal;
-  options.record_devices = plan.recorded();
-  options.script_alongside = plan.script_alongside;
+  options.stop.interrupt = &g_interrupt;
+  options.stop.signal = &g_signal;
+  options.devices.record = plan.recorded();
+  options.devices.script_alongside = plan.script_alongside;
   // Devices are built when the run starts (run_scenario), so that every one built is released
   // however the run ends; a device that cannot be built ends the run with its error (exit 2).
-  options.make_device = [&](std::size_t f) { return graspsim::app::make_device(plan, registry, *scenario, f); };
+  options.devices.make = [&](std::size_t f) { return graspsim::app::make_device(plan, registry, *scenario, f); };
   // A hand on a real device: pace the loop in real time on a SCHED_FIFO thread if allowed.
   graspsim::app::SteadyClock steady;
   std::optional<graspsim::app::Pacer> pacer;
   if (plan.any_real()) {
     pacer.emplace(steady, scenario->model().rates.servo, graspsim::app::kStallTimeout);
-    options.pacer = &*pacer;
-    options.force_ramp = graspsim::app::kForceRamp;
+    options.pacing.pacer = &*pacer;
     const std::string why = graspsim::app::probe_realtime();
-    options.realtime = why.empty();
+    options.pacing.realtime = why.empty();
     if (!why.empty()) std::cerr << "graspsim: warning: " << why << "\n";
   }
   const bool tty = isatty(STDERR_FILENO) && !quiet && !pacer;
   if (tty) {
-    options.progress = [](double t, double duration) {
+    options.report.progress = [](double t, double duration) {
       std::fprintf(stderr, "\r  running: %5.1f%%  t = %.2f of %.2f s", 100.0 * t / duration, t, duration);
       std::fflush(stderr);
     };
   }
   handle_stop_signals();
-  options.refuse_unstable = refuse_unstable;
+  options.report.refuse_unstable = refuse_unstable;
   // Each stability warning as it is found (the progress line, if any, is cleared first).
-  options.on_warning = [tty](const std::string& w) {
+  options.report.on_warning = [tty](const std::string& w) {
     if (tty) std::fprintf(stderr, "\r%60s\r", "");
     std::cerr << "graspsim: warning: " << w << "\n";
   };
@@ -365,7 +364,7 @@ int run_command(const std::vector<std::string>& args) {
     if (scenario->jitter().amplitude > 0.0)
       std::printf("  jitter      waypoints moved by up to %g m per axis, seed %llu (trace: jitter_offsets)\n",
                   scenario->jitter().amplitude, static_cast<unsigned long long>(scenario->jitter().seed));
-    if (pacer) std::printf("  pacing      %s%s\n", result.pacing.c_str(), options.realtime ? ", SCHED_FIFO" : "");
+    if (pacer) std::printf("  pacing      %s%s\n", result.pacing.c_str(), options.pacing.realtime ? ", SCHED_FIFO" : "");
   }
   if (!result.trace_error.empty()) {
     std::fprintf(stderr, "graspsim: the trace could not be written to its end: %s\n", result.trace_error.c_str());

@@ -1,5 +1,5 @@
-// graspsim replay TRACE.h5: the recorded scenario, fed from the recorded device samples
-// (README.md, "Replaying a trace").
+// graspsim replay TRACE.h5: its arguments and its report. The replay itself, and its comparison
+// with the recording, is app::run_replay (app/replay.hpp; README.md, "Replaying a trace").
 #include "cli/replay.hpp"
 
 #include <cmath>
@@ -59,9 +59,6 @@ int bad_input(const std::string& message) {
   return kExitBadInput;
 }
 
-std::string default_out(const std::string& trace) {
-  return std::filesystem::path(trace).stem().string() + ".replay.h5";
-}
 
 }  // namespace
 
@@ -104,7 +101,7 @@ int replay_command(const std::vector<std::string>& args, const std::atomic<bool>
     }
   }
   if (trace.empty()) return bad_input("replay needs a trace file (graspsim replay --help)");
-  if (out.empty()) out = default_out(trace);
+  if (out.empty()) out = app::default_replay_out(trace);
   std::error_code ec;
   if (std::filesystem::equivalent(trace, out, ec) || std::filesystem::absolute(trace) == std::filesystem::absolute(out)) {
     return bad_input("--out " + out + " is the trace being replayed: it would be written over");
@@ -119,23 +116,23 @@ int replay_command(const std::vector<std::string>& args, const std::atomic<bool>
   for (const std::string& note : plan.notes) std::cerr << "graspsim: replay: " << note << "\n";
 
   app::RunOptions options = plan.run_options(out);
-  options.compression = compression;
-  options.interrupt = interrupt;
-  options.interrupt_signal = signal;
-  options.inputs.push_back({trace, "the trace replayed"});
+  options.trace.compression = compression;
+  options.stop.interrupt = interrupt;
+  options.stop.signal = signal;
   // The replay's trace is as large as the recording: refused if it will not fit.
   std::string size_warning;
   const std::string too_big = app::check_run_fits(*plan.scenario, options, &size_warning);
   if (!too_big.empty()) return bad_input("replay: " + too_big);
   if (!size_warning.empty()) std::cerr << "graspsim: warning: " << size_warning << "\n";
-  app::RunResult result;
+  app::ReplayOutcome outcome;
   try {
-    result = app::run_scenario(*plan.scenario, options);
+    outcome = app::run_replay(plan, options);
   } catch (const app::OutputError& e) {
     return bad_input(e.what());
   } catch (const recordings::TraceError& e) {
     return bad_input(std::string("cannot write the trace: ") + e.what());
   }
+  const app::RunResult& result = outcome.run;
   if (result.not_started) return bad_input("the replay could not start: " + result.error + " (nothing was written)");
 
   const auto& scenario = *plan.scenario;
@@ -160,40 +157,31 @@ int replay_command(const std::vector<std::string>& args, const std::atomic<bool>
   }
 
   // The new trace against the recording, bit for bit, on the ticks both hold.
-  bool reproduced = false;
-  try {
-    recordings::CompareOptions bitwise;
-    bitwise.bitwise = true;
-    const recordings::CompareResult c = recordings::compare_traces(trace, result.trace_path, bitwise);
-    reproduced = c.same();
-    std::int64_t hashes = 0;
-    for (const auto& d : c.datasets)
-      if (d.path == "physics/state_hash") hashes = d.elements;
-    if (reproduced) {
-      if (!quiet)
-        std::printf("  reproduced  bit for bit: %zu datasets, state_hash equal at all %lld physics ticks\n",
-                    c.datasets.size(), static_cast<long long>(hashes));
-    } else {
-      const recordings::DatasetResult& d = c.datasets.front();   // the first to part
-      const recordings::ElementPoint& p = *d.first;
-      const std::string component = d.components.size() > 1 ? " " + d.components[p.component] : "";
-      std::printf("  %s %s tick %lld (t = %.9g s): %s%s%s %s%s (%.17g, replay %.17g); %lld of %zu datasets "
-                  "differ (graspsim compare %s %s)\n",
-                  plan.what_if ? "parts       from the recording at" : "DIFFERS     from the recording at",
-                  d.loop.c_str(), static_cast<long long>(p.tick), p.time, d.kind.c_str(),
-                  d.kind.empty() ? "" : " ", d.name.c_str(), d.quantity.c_str(), component.c_str(), p.a, p.b,
-                  static_cast<long long>(c.differing_datasets()), c.datasets.size(), trace.c_str(),
-                  result.trace_path.c_str());
-    }
-  } catch (const recordings::TraceError& e) {
-    std::fprintf(stderr, "graspsim: cannot compare the replay with the recording: %s\n", e.what());
+  if (!outcome.comparison) {
+    std::fprintf(stderr, "graspsim: cannot compare the replay with the recording: %s\n", outcome.compare_error.c_str());
+  } else if (outcome.reproduced()) {
+    if (!quiet)
+      std::printf("  reproduced  bit for bit: %zu datasets, state_hash equal at all %lld physics ticks\n",
+                  outcome.comparison->datasets.size(), static_cast<long long>(outcome.state_hashes()));
+  } else {
+    const recordings::CompareResult& c = *outcome.comparison;
+    const recordings::DatasetResult& d = c.datasets.front();   // the first to part
+    const recordings::ElementPoint& p = *d.first;
+    const std::string component = d.components.size() > 1 ? " " + d.components[p.component] : "";
+    std::printf("  %s %s tick %lld (t = %.9g s): %s%s%s %s%s (%.17g, replay %.17g); %lld of %zu datasets "
+                "differ (graspsim compare %s %s)\n",
+                plan.what_if ? "parts       from the recording at" : "DIFFERS     from the recording at",
+                d.loop.c_str(), static_cast<long long>(p.tick), p.time, d.kind.c_str(),
+                d.kind.empty() ? "" : " ", d.name.c_str(), d.quantity.c_str(), component.c_str(), p.a, p.b,
+                static_cast<long long>(c.differing_datasets()), c.datasets.size(), trace.c_str(),
+                result.trace_path.c_str());
   }
 
   const int failed = print_expectations(result, quiet);
   if (!result.trace_error.empty()) return kExitTraceFault;
   if (result.interrupted) return exit_interrupted(signal);
   if (!result.error.empty()) return kExitBadInput;
-  if (!plan.what_if && !reproduced) return kExitFailed;
+  if (!plan.what_if && !outcome.reproduced()) return kExitFailed;
   return failed ? kExitFailed : kExitOk;
 }
 

@@ -39,7 +39,8 @@ struct DecimateOptions {
                                  //    that wrote this golden changed against the one before
 };
 
-// Writes the decimated copy of trace `in` to `out` (replacing it). Throws
+// Writes the decimated copy of trace `in` to `out` (replacing it), through
+// recordings::decimate_trace with the stride above and the golden's root attributes. Throws
 // recordings::TraceError naming the file and dataset on failure.
 void decimate_trace(const std::string& in, const std::string& out, const DecimateOptions& options = {});
 

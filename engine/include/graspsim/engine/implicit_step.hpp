@@ -14,6 +14,16 @@
 
 namespace graspsim {
 
+// What the second-order step needs of the last one, per body (ImplicitStep::solve).
+struct StepHistory {
+  int order = 1;                            // 1: backward Euler everywhere; 2: BDF2 where the history allows
+  std::vector<std::uint8_t> valid;          // stepped at the last physics tick (awake since)
+  std::vector<Vec3> v_mean;                 // m/s, world: (x0 - x_-1) / h, the last step's displacement rate
+  std::vector<Vec3> w_mean;                 // rad/s, world: the last step's rotation vector / h
+  std::vector<std::uint64_t> signature;     // its island's couplings and their modes at the last step
+  std::vector<int> steps;                   // 1: physics steps in a row its island kept that signature
+};
+
 // The solver's buffers, sized once for the model so that the step allocates nothing.
 class ImplicitStep {
  public:
@@ -24,7 +34,16 @@ class ImplicitStep {
 
   // Solves (M + h C + h^2 K) q1 = M q0 + h (Q + sum J^T (force + C u0)) for the bodies'
   // velocities q1 = (v1, w1) at the end of the step, island by island, with the active set of
-  // the couplings' unilateral and friction limits. `q0` holds each body's (v, w) at the start
+  // the couplings' unilateral and friction limits (backward Euler). Under `history.order` 2 an
+  // island whose bodies all kept the same couplings in the same modes for kSettledSteps, with no
+  // axis rule, no finger, no other body and the gyroscopic term neglected (a body alone, free or
+  // on the floor), takes the BDF2 step instead
+  // (engine/README.md, "Second order"):
+  //   (M + h2 C + h2^2 K) q1 = M q^ + h2 (Q + sum J^T (force + C u0 - h/3 K u_mean)),
+  //   h2 = 2h/3,  q^ = (4 q0 - q_-1) / 3,  displacement h (q_mean + 2 q1) / 3,
+  // and if the solve's modes differ from the last step's, the island is solved again by backward
+  // Euler (a restart: BDF2 across a change of the active set can throw a body off a new contact
+  // faster than it came). `q0` holds each body's (v, w) at the start
   // (after the gyroscopic change), `wrench` the external force and torque on each body over the
   // step (gravity, fingers' window), `awake` which bodies move. Results: velocities(), mode(i)
   // and force(i) for every coupling, solved at the end of the step.
@@ -36,20 +55,33 @@ class ImplicitStep {
              const std::vector<Vec3>& w0, const std::vector<Vec3>& force,
              const std::vector<Vec3>& torque, const std::vector<std::uint8_t>& axis_active,
              const std::vector<Vec3>& axis, const std::vector<Vec3>& axis_point,
-             const std::vector<double>& axis_rate, double h);
+             const std::vector<double>& axis_rate, const StepHistory& history, double h);
 
   const Vec3& velocity(int body) const { return v1_[body]; }            // m/s, world
   const Vec3& angular_velocity(int body) const { return w1_[body]; }    // rad/s, world
   CouplingMode mode(std::size_t coupling) const { return mode_[coupling]; }
   // N, world, on b: the coupling's force at the end of the step (zero when kOff).
   const Vec3& force(std::size_t coupling) const { return solved_[coupling]; }
+  // Whether the body's island took the BDF2 step, and its signature (couplings and modes) now.
+  bool second_order(int body) const { return second_order_[body] != 0; }
+  std::uint64_t signature(int body) const { return signature_[body]; }
 
   // Most active-set rounds per island: each round changes at least one point's mode, hold ->
   // slip -> off, never back, so the set settles; the cap bounds the cost of a rare long cascade.
   static constexpr int kMaxRounds = 8;
+  // Steps an island's contacts must keep unchanged before it takes BDF2: backward Euler damps
+  // the transient of an arrival (a stiff spring's mode by 1 / sqrt(1 + h^2 k / m) a step, BDF2's
+  // only by (4 h^2 k / m)^(-1/4)), so that a body bounced off a new contact settles into it
+  // instead of overshooting out of reach of a one-sided point.
+  static constexpr int kSettledSteps = 3;
 
  private:
   int find(int body);
+  void solve_island(const Model& model, const State& state, const std::vector<Coupling>& couplings,
+                    const std::vector<Vec3>& force, const std::vector<Vec3>& torque,
+                    const std::vector<std::uint8_t>& axis_active, const std::vector<Vec3>& axis,
+                    const std::vector<Vec3>& axis_point, const std::vector<double>& axis_rate, double h);
+  std::uint64_t island_signature(const std::vector<Coupling>& couplings) const;
   void assemble_and_solve(const Model& model, const State& state, const std::vector<Coupling>& couplings,
                           const std::vector<Vec3>& v0, const std::vector<Vec3>& w0,
                           const std::vector<Vec3>& force, const std::vector<Vec3>& torque,
@@ -74,6 +106,10 @@ class ImplicitStep {
                                             //    force while kSlip
   std::vector<Vec3> solved_;                // N, world, per coupling: force at the end of the step
   std::vector<Vec3> u0_;                    // m/s, world, per coupling: relative velocity at the start
+  std::vector<Vec3> start_force_;           // N, world, per coupling: `force`, less h/3 K u_mean under BDF2
+  std::vector<Vec3> vq_, wq_;               // m/s, rad/s, per body: q0, or q^ under BDF2
+  std::vector<std::uint8_t> second_order_;  // per body: its island took the BDF2 step
+  std::vector<std::uint64_t> signature_;    // per body: its island's couplings and modes
   std::vector<int> current_;                // the island being solved: its bodies, couplings
   std::vector<int> current_couplings_;
 };

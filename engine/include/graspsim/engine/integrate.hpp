@@ -53,6 +53,14 @@ void integrate_body(const BodyParams& params, Gyroscopic gyroscopic, BodyState& 
 // scenarios at 50 Hz.) The gyroscopic change, if any, is in w0 already (gyroscopic_change()).
 void move_body(const BodyParams& params, BodyState& body, const Vec3& force, const Vec3& torque, double dt);
 
+// The BDF2 move, the displacement the second-order solve assumed (implicit_step.hpp): the body
+// takes the end velocities v1, w1 (m/s, rad/s, world) and moves by
+//   p = p + dt (v_mean + 2 v1) / 3      R = exp(S(dt (w_mean + 2 w1) / 3)) R_old
+// where v_mean, w_mean are the last step's displacement rates. Under constant force this is
+// exact: x(t) = a t^2 / 2 is a polynomial of degree two, which BDF2 reproduces.
+void move_body_bdf2(BodyState& body, const Vec3& v1, const Vec3& w1, const Vec3& v_mean, const Vec3& w_mean,
+                    double dt);
+
 // The gyroscopic change of the world angular velocity w over dt under `gyroscopic` (zero for
 // kNeglect), as integrate_body applies it before the torque's change.
 Vec3 gyroscopic_change(const BodyParams& params, Gyroscopic gyroscopic, const BodyState& body, double dt);

@@ -83,6 +83,7 @@ class Simulation {
   std::vector<std::uint8_t> floor_clear_;  // per body: 1 when none of its floor points is active
   // The implicit step's buffers (sized once).
   ImplicitStep implicit_;
+  StepHistory history_;                   // per body: what the BDF2 step needs of the last step
   std::vector<Coupling> couplings_;       // this step's contact points
   std::vector<std::uint8_t> awake_;       // per body: 1 when stepped
   std::vector<Vec3> v0_, w0_;             // m/s, rad/s, per body: velocities at the start of the step

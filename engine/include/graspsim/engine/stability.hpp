@@ -38,8 +38,12 @@ inline constexpr double kUnstableRadius = 1.0 + 1e-6;
 //   kImplicit (linearised backward Euler, implicit_step.hpp: the pose moves by h v1):
 //     S y1 = y0 - h^2 K' z0,  S = I + h C' + h^2 K',   z1 = z0 + y1
 // The map is the 2n x 2n matrix A with (z1, y1) = A (z0, y0).
+//   kImplicit with implicit_order 2 (BDF2, its restarts aside):
+//     S2 y1 = (4 y0 - y_-1) / 3 - (2/3) h^2 K' (4 z0 - z_-1) / 3,  S2 = I + (2/3) h C' + (4/9) h^2 K'
+//     z1 = (4 z0 - z_-1) / 3 + (2/3) y1
+//   a 4n x 4n map of (z0, y0, z_-1, y_-1); its first n components are still z0.
 Eigen::MatrixXd one_step_map(Integrator integrator, const Eigen::MatrixXd& stiffness_over_mass,
-                             const Eigen::MatrixXd& damping_over_mass, double h);
+                             const Eigen::MatrixXd& damping_over_mass, double h, int implicit_order);
 
 // The largest |lambda| over the eigenvalues of `map` (Eigen's EigenSolver: the same input gives
 // the same output).

@@ -92,6 +92,12 @@ struct BodyState {
   Vec3 position_before_step{0.0, 0.0, 0.0};       // m, world
   Mat3 rotation_before_step = Mat3::Identity();   // 1: body to world
   std::int64_t stepped_at = -1;                   // servo tick of the last physics step (-1: none)
+  // The last implicit step, for the next one's BDF2 (implicit_step.hpp, StepHistory): the
+  // velocities at its start, and its island's couplings and their modes (0: none, a restart).
+  Vec3 velocity_before_step{0.0, 0.0, 0.0};           // m/s, world
+  Vec3 angular_velocity_before_step{0.0, 0.0, 0.0};   // rad/s, world
+  std::uint64_t island_signature = 0;                 // 1
+  int island_steps = 0;                               // 1: physics steps in a row with that signature
   bool asleep = false;       // sleeping: not stepped, pose frozen, velocities zero (Model::sleep)
   int still_steps = 0;       // 1: physics steps in a row with |v| and |w| under the sleep thresholds
   std::vector<VertexContact> floor_contacts;   // one per floor point of the shape (object_contact.hpp),

@@ -8,9 +8,9 @@
 
 #include <Eigen/Core>
 
-namespace graspsim::hw {
+#include "graspsim/hw/force_safety.hpp"
 
-using Vec3 = Eigen::Vector3d;
+namespace graspsim::hw {
 
 // One reading of a device, already mapped into the world frame.
 struct DeviceSample {
@@ -39,21 +39,13 @@ inline constexpr double kDeviceReach = 1.0;     // m
 inline constexpr double kWorldReach = 1000.0;   // m
 Workspace reach_box(double half_side);          // [-half_side, half_side]^3, m
 
-struct DeviceLimits {
-  double max_force = 10.0;   // N: largest force magnitude the device may render
-};
-
-// Force safety, in one place: the largest force a device may be asked for is the limit, in the
-// direction asked; NaN or infinite components render zero (a non-finite request is a fault, and
-// the safe output for a fault is no force).
-Vec3 clamp_force(const Vec3& force, const DeviceLimits& limits);
-
 class Device {
  public:
   virtual ~Device() = default;
   // Reads the sample for servo tick `tick` at simulated time `time` (s). Must not block.
   virtual DeviceSample read(std::int64_t tick, double time) = 0;
-  // Renders `force` (N, world) after clamping it to limits(); returns what was rendered.
+  // Renders `force` (N, world) after clamping it to limits() (force_safety.hpp); returns what
+  // was rendered.
   Vec3 render(const Vec3& force) {
     const Vec3 safe = clamp_force(force, limits());
     output(safe);
@@ -69,6 +61,28 @@ class Device {
   // Where this device's samples may be, in its own frame: reach_box(kDeviceReach) unless the
   // device knows better (a simulated Phantom: its box) or has no device frame (kWorldReach).
   virtual Workspace workspace() const { return reach_box(kDeviceReach); }
+
+  // What a device says of itself for its /devices/<finger> table (recordings/README.md), so the
+  // run loop asks the interface instead of probing types. The defaults describe a device with no
+  // clock of its own, no sample numbers, no recorded pacing, and the world as its frame.
+  // Its own clock: whether it has one, and when the last read sample was taken on it (s).
+  virtual bool has_sample_clock() const { return false; }
+  virtual double sample_time() const { return 0.0; }
+  // 1: the device's number of the sample the last read() returned (-1: none, or before any);
+  // UDP: the server's sequence number; OpenHaptics: the HD servo frame it was read in.
+  virtual std::int64_t sample_sequence() const { return -1; }
+  // 1: new samples between the previous read() and the last one (0: held; -1: not known).
+  virtual std::int64_t new_samples() const { return -1; }
+  // A replayed device: whether the recorded run overran the tick of the last sample read
+  // (has_recorded_pacing false: the run's own pacing decides).
+  virtual bool has_recorded_pacing() const { return false; }
+  virtual bool recorded_overrun() const { return false; }
+  // Its own frame when that is not the world (a workspace mapping, MappedDevice): the last sample
+  // as the device gave it and the last force sent to it, both in that frame (nullptr: the frame is
+  // the world, so they are what read() returned and render() rendered), and the mapping as text.
+  virtual const DeviceSample* device_frame_sample() const { return nullptr; }
+  virtual const Vec3* device_frame_force() const { return nullptr; }
+  virtual std::string mapping_text() const { return "identity (device frame = world)"; }
 
  protected:
   // Sends an already clamped force to the hardware (or stores it).

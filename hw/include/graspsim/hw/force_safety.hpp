@@ -1,12 +1,18 @@
-// Force safety for a device, in one class: every force leaving it is
+// Force safety, in one place: every rule a force obeys on its way to a device.
+//   0. Device::render clamps every force to the device's limits (clamp_force below), and
+//      Device::release renders zero; the run loop releases every device when it stalls, falls
+//      behind, fails or ends.
+// Inside a backend with a motor model, ForceSafety then holds each force to the current limit:
 //   1. clamped to the peak limit (clamp_force: NaN or infinite requests render zero),
 //   2. derated by a thermal model so the continuous limit holds in the long run,
-//   3. ramped in over a rise time after start (and after every stall or release),
+//   3. ramped in over a rise time after start (and after every stall or release): the one force
+//      ramp, a limit that rises from 0 to P, so no force jumps on, and one below the ramping
+//      limit is rendered whole (a hand's small corrections act from the start),
 //   4. zero when no request came for `stall_timeout` of the device clock, and after release().
 // It is driven by an injected time (s, the device's own clock); it never reads a clock.
 //
 // Laws (hw/README.md, "Force safety"):
-//   ramp:     L_ramp(t) = P min(1, (t - t_start) / T_rise)
+//   ramp:     L_ramp(t) = P ramp_fraction(t - t_start, T_rise)   (the one ramp law, below)
 //   thermal:  H, the exponentially time-averaged squared force, time constant tau:
 //             H(t + dt) = H(t) + (1 - exp(-dt / tau)) (|F|^2 - H(t))  with F held over dt;
 //             L_therm^2 = P^2 - (P^2 - C^2) H / C^2   (P when cold, C when H = C^2).
@@ -18,9 +24,24 @@
 //   limit:    L(t) = min(L_ramp, L_therm), and 0 when stalled or released.
 #pragma once
 
-#include "graspsim/hw/device.hpp"
+#include <Eigen/Core>
 
 namespace graspsim::hw {
+
+using Vec3 = Eigen::Vector3d;
+
+struct DeviceLimits {
+  double max_force = 10.0;   // N: largest force magnitude the device may render
+};
+
+// The largest force a device may be asked for is the limit, in the direction asked; NaN or
+// infinite components render zero (a non-finite request is a fault, and the safe output for a
+// fault is no force).
+Vec3 clamp_force(const Vec3& force, const DeviceLimits& limits);
+
+// The ramp law: the fraction of the peak the limit allows a time `elapsed` (s) after the ramp
+// starts, r = min(1, elapsed / T_rise) for elapsed >= 0, 0 before, and 1 when T_rise = 0 (no ramp).
+double ramp_fraction(double elapsed, double rise_time);
 
 struct ForceSafetyConfig {
   double peak_force = 8.5;               // N: P, the largest force ever rendered

@@ -44,6 +44,16 @@ class MappedDevice final : public Device {
   Workspace workspace() const override { return device_->workspace(); }   // the device frame's
   const DeviceSample& last_device_sample() const { return last_sample_; }   // device frame
   const Vec3& last_device_force() const { return last_force_; }             // N, device frame
+  // The device frame for its /devices table; clock, numbering and pacing are the wrapped device's.
+  const DeviceSample* device_frame_sample() const override { return &last_sample_; }
+  const Vec3* device_frame_force() const override { return &last_force_; }
+  std::string mapping_text() const override;   // "scale S; offset X Y Z m; rotation R P Y rad", %.17g
+  bool has_sample_clock() const override { return device_->has_sample_clock(); }
+  double sample_time() const override { return device_->sample_time(); }
+  std::int64_t sample_sequence() const override { return device_->sample_sequence(); }
+  std::int64_t new_samples() const override { return device_->new_samples(); }
+  bool has_recorded_pacing() const override { return device_->has_recorded_pacing(); }
+  bool recorded_overrun() const override { return device_->recorded_overrun(); }
   Device& inner() { return *device_; }
   const Device& inner() const { return *device_; }
   const WorkspaceMapping& mapping() const { return mapping_; }

@@ -16,8 +16,6 @@
 #include <string>
 
 #include "graspsim/hw/device.hpp"
-#include "graspsim/hw/sample_clock.hpp"
-#include "graspsim/hw/sample_counter.hpp"
 
 namespace graspsim::hw {
 
@@ -45,10 +43,11 @@ struct PhantomNominal {
 };
 
 // The device make_openhaptics_device returns, for callers that want its start-up figures
-// (dynamic_cast the Device to it). Its clock (SampleClock) counts its own servo frames: the
-// sample read in frame k (0 = the first frame served) was taken at k / rate s, rate from
-// HD_UPDATE_RATE; its SampleCounter gives k and the frames since the previous read's sample.
-class OpenHapticsDevice : public Device, public SampleClock, public SampleCounter {
+// (dynamic_cast the Device to it). Its clock (Device::sample_time) counts its own servo frames:
+// the sample read in frame k (0 = the first frame served) was taken at k / rate s, rate from
+// HD_UPDATE_RATE; Device::sample_sequence gives k, new_samples the frames since the previous
+// read's sample.
+class OpenHapticsDevice : public Device {
  public:
   virtual PhantomNominal nominal() const = 0;
   virtual std::string config_name() const = 0;   // the configured name that opened

@@ -1,6 +1,6 @@
 // A finger fed from recorded device samples (a trace's /servo hip and gimbal): row n is the
 // sample of servo tick n. The samples are an in-memory table; reading the trace that holds
-// them is the caller's job (tools/app/replay.cpp), so hw/ needs no HDF5.
+// them is the caller's job (app/replay.cpp), so hw/ needs no HDF5.
 #pragma once
 
 #include <cstdint>

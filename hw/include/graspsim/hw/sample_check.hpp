@@ -11,7 +11,7 @@
 #include <string>
 
 #include "graspsim/hw/device.hpp"
-#include "graspsim/hw/mapped_device.hpp"
+
 
 namespace graspsim::hw {
 
@@ -33,7 +33,7 @@ class SampleCheck {
   [[noreturn]] void refuse(std::int64_t tick, double time, const std::string& what) const;
 
   const Device& device_;
-  const MappedDevice* mapped_ = nullptr;   // the device, if it is a mapped one
+  bool mapped_ = false;   // its frame is not the world (Device::device_frame_sample)
   Workspace workspace_;                    // m, the device's own frame
   std::string finger_;
 };

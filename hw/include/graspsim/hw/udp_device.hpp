@@ -9,8 +9,6 @@
 
 #include "graspsim/hw/device.hpp"
 #include "graspsim/hw/force_safety.hpp"
-#include "graspsim/hw/sample_clock.hpp"
-#include "graspsim/hw/sample_counter.hpp"
 #include "graspsim/hw/udp_protocol.hpp"
 
 namespace graspsim::hw {
@@ -47,7 +45,7 @@ struct UdpDeviceConfig {
 };
 
 // Counts since the device was made (the trace has the per-tick `sequence` and `new_samples`
-// instead: hw::SampleCounter).
+// instead: Device::sample_sequence).
 struct UdpCounters {
   std::uint64_t received = 0;    // samples accepted (newer than every sample before)
   std::uint64_t lost = 0;        // sample sequence numbers skipped between accepted samples
@@ -101,7 +99,7 @@ class UdpLink {
   UdpCounters counters_{};
 };
 
-class UdpDevice final : public Device, public SampleClock, public SampleCounter {
+class UdpDevice final : public Device {
  public:
   // Opens a non-blocking UDP socket bound to config.local_port, connected to host:port (so only
   // the server's datagrams are received), and sends a hello. Throws std::runtime_error naming
@@ -118,6 +116,7 @@ class UdpDevice final : public Device, public SampleClock, public SampleCounter 
   DeviceLimits limits() const override;    // N: min(config.limits, the safety's peak)
   std::string describe() const override;   // "udp 127.0.0.1:7001 (touch: 3.3 N peak, 0.88 N continuous)"
   // s: the newest sample's device time, from its datagram (0 before the first sample).
+  bool has_sample_clock() const override { return true; }
   double sample_time() const override { return link_.has_sample() ? link_.newest().device_time : 0.0; }
   // 1: the newest sample's sequence number (-1 before the first); samples accepted by the last read.
   std::int64_t sample_sequence() const override {

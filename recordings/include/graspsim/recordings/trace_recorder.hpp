@@ -1,5 +1,6 @@
 // TraceRecorder: maps the engine's per-tick records onto the trace schema (/servo, /haptic,
-// /physics; see recordings/README.md).
+// /physics; the columns are the field tables of trace_schema.hpp, documented in
+// recordings/README.md).
 #pragma once
 
 #include <cstddef>
@@ -54,35 +55,17 @@ class TraceRecorder {
               const graspsim::Input& input, const graspsim::State& after);
 
  private:
-  struct ServoColumns {
-    std::size_t hip;            // offset of fingers/<name>/hip
-    std::size_t force;          // offset of fingers/<name>/force
-    std::size_t force_demand;   // offset of fingers/<name>/force_demand
-    std::size_t gimbal;         // offset of fingers/<name>/gimbal
-  };
-  struct HapticColumns {
-    std::size_t god_object, surface_point, depth, friction_radius, force, state, body, slip;
-  };
-  struct PhysicsColumns {
-    std::size_t position, quaternion, velocity, angular_velocity, force, torque, floor_contacts,
-        body_contacts, grasp_area, torsion, twist;
-  };
-  struct TimeColumns {
-    std::size_t tick;   // offset of tick
-    std::size_t time;   // offset of time
-  };
-
   TraceTable& servo_;
   TraceTable& haptic_;
   TraceTable& physics_;
   double servo_rate_;   // Hz
-  TimeColumns servo_time_;
-  TimeColumns haptic_time_;
-  TimeColumns physics_time_;
-  std::size_t state_hash_;                      // offset of /physics/state_hash
-  std::vector<ServoColumns> servo_fingers_;     // Model::fingers order
-  std::vector<HapticColumns> haptic_fingers_;   // Model::fingers order
-  std::vector<PhysicsColumns> objects_;         // Model::bodies order
+  // Offsets into a row of each record's first column; its fields follow it in table order
+  // (trace_schema.hpp).
+  std::size_t servo_loop_ = 0, haptic_loop_ = 0, physics_loop_ = 0;   // tick, time
+  std::size_t physics_hash_ = 0;                                      // state_hash
+  std::vector<std::size_t> servo_fingers_;    // Model::fingers order
+  std::vector<std::size_t> haptic_fingers_;   // Model::fingers order
+  std::vector<std::size_t> objects_;          // Model::bodies order
 };
 
 }  // namespace graspsim::recordings

@@ -24,6 +24,28 @@ class TraceError : public std::runtime_error {
 // kUInt64 carries 64 raw bits (a hash) through the row: put them there with uint64_in_row().
 enum class DType { kFloat64, kInt64, kInt32, kInt8, kUInt64 };
 
+// Bytes of one stored element.
+constexpr std::size_t size_of(DType dtype) {
+  switch (dtype) {
+    case DType::kFloat64: case DType::kInt64: case DType::kUInt64: return 8;
+    case DType::kInt32: return 4;
+    case DType::kInt8: return 1;
+  }
+  return 8;
+}
+
+// The name recordings/README.md gives the type ("float64", "int32", ...).
+constexpr const char* name_of(DType dtype) {
+  switch (dtype) {
+    case DType::kFloat64: return "float64";
+    case DType::kInt64: return "int64";
+    case DType::kInt32: return "int32";
+    case DType::kInt8: return "int8";
+    case DType::kUInt64: return "uint64";
+  }
+  return "?";
+}
+
 // The row value of a kUInt64 column: the 64 bits of `value` carried in a double, unchanged
 // (written back bit for bit; never do arithmetic on it).
 inline double uint64_in_row(std::uint64_t value) { return std::bit_cast<double>(value); }

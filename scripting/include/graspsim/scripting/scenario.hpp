@@ -29,7 +29,7 @@ class LuaSandbox;
 struct FingerSetup {
   hw::DeviceLimits limits;   // clamp for rendered forces
   // `device = { default = SPEC, scale, offset, rotation }`: the finger's device when the command
-  // line names none (a --device SPEC, tools/app/devices.hpp; "scripted" unless given) and the
+  // line names none (a --device SPEC, app/devices.hpp; "scripted" unless given) and the
   // mapping of that device's workspace into the world (not applied to scripted fingers, whose
   // trajectories are already in the world).
   std::string device = "scripted";
@@ -99,7 +99,7 @@ struct Jitter {
 //   rate decides its memory: at 100 kHz 25,000 rows a table.
 // - kMaxDuration: 24 h of simulated time, longer than any session with a hand on a device (the
 //   library's longest scenario runs 7.5 s); at 3 kHz, 259 million servo rows (63 GB for the lift).
-// What the machine can hold below them is checked before a run (tools/app/run_budget.hpp).
+// What the machine can hold below them is checked before a run (app/run_budget.hpp).
 inline constexpr int kMaxServoRate = 100'000;    // Hz
 inline constexpr double kMaxDuration = 86'400.0;  // s
 
@@ -160,7 +160,7 @@ class Scenario {
   // it runs are thrown as ScenarioError with file:line and a traceback.
   std::unique_ptr<hw::Trajectory> make_trajectory(std::size_t finger) const;
 
-  // Paced runs (tools/app/script_thread.hpp, scripting/README.md "Threads"): while set,
+  // Paced runs (app/script_thread.hpp, scripting/README.md "Threads"): while set,
   // make_trajectory hands every Lua function trajectory (waypoints need no Lua) to the wrapper,
   // with its finger, and returns what the wrapper returns: a trajectory fed by a script thread.
   // An empty function removes it. Not thread-safe: set it before devices are built.

@@ -1,7 +1,10 @@
-// Replaying a trace: the recorded scenario (the trace's own scenario_source and overrides, plus
-// any new --set) rerun with every finger fed from its recorded device samples (/servo hip and
-// gimbal, row n = servo tick n) instead of its script. The trace is read here (HDF5 stays out
-// of hw/ and engine/); the fingers are hw::ReplayDevice. See README.md, "Replaying a trace".
+// Replaying a trace, in one place: the recorded scenario (the trace's own scenario_source and
+// overrides, plus any new --set) rerun with every finger fed from its recorded device samples
+// (/servo hip and gimbal, row n = servo tick n; /devices rows through the recorded mapping)
+// instead of its script, and the new trace compared with the recording bit for bit. The trace is
+// read here (HDF5 stays out of hw/ and engine/); the fingers are hw::ReplayDevice. `graspsim
+// replay` (tools/cli/replay.cpp) parses its arguments and prints what run_replay returns. See
+// README.md, "Replaying a trace".
 #pragma once
 
 #include <cstdint>
@@ -14,6 +17,7 @@
 #include "app/run.hpp"
 #include "graspsim/hw/device.hpp"
 #include "graspsim/hw/mapped_device.hpp"
+#include "graspsim/recordings/trace_compare.hpp"
 #include "graspsim/scripting/scenario.hpp"
 
 namespace graspsim::app {
@@ -70,12 +74,11 @@ struct ReplayPlan {
   std::int64_t recorded_ticks = 0;        // servo ticks with a sample for every finger
   std::int64_t scenario_ticks = 0;        // duration * rate_servo of the (overridden) scenario
   bool what_if = false;                   // ReplayOptions::sets was not empty
-  double force_ramp = 0.0;                // s: the recorded run's force ramp (root `force_ramp`)
   std::vector<std::string> notes;         // e.g. a cut trace replayed up to its last tick
   // The root attribute a replay trace carries: "<trace as given>\n<its scenario_source_hash>".
   std::string replay_of() const;
-  // RunOptions that replay this plan (devices, max_ticks, overrides, replay_of) into `out`.
-  // The plan must outlive the run.
+  // RunOptions that replay this plan (devices, max_ticks, overrides, replay_of) into `out`, with
+  // the trace replayed among the inputs (the output may not be it). The plan must outlive the run.
   RunOptions run_options(const std::string& out) const;
 };
 
@@ -89,5 +92,23 @@ RecordedFinger read_recorded_finger(const std::string& trace, const std::string&
 // Reads the trace's scenario and device samples and checks that they can be replayed.
 // Throws ReplayError (bad input) with the file and the dataset, attribute or field named.
 ReplayPlan load_replay(const std::string& trace, const ReplayOptions& options = {});
+
+// The replay's trace when none is named: "<trace's stem>.replay.h5" in the working directory.
+std::string default_replay_out(const std::string& trace);
+
+// A replay and its verdict against the recording.
+struct ReplayOutcome {
+  RunResult run;
+  // The new trace against the recording, bitwise, on the ticks both hold (recordings::
+  // compare_traces); `compare_error` says why there is none (a trace that cannot be read).
+  std::optional<recordings::CompareResult> comparison;
+  std::string compare_error;
+  bool reproduced() const { return comparison && comparison->same(); }
+  std::int64_t state_hashes() const;   // physics ticks whose state_hash was compared
+};
+
+// Runs `plan` with `options` (from plan.run_options) and compares the new trace with the
+// recording. Throws what run_scenario throws (OutputError, recordings::TraceError).
+ReplayOutcome run_replay(const ReplayPlan& plan, const RunOptions& options);
 
 }  // namespace graspsim::app

@@ -27,7 +27,7 @@ std::unique_ptr<hw::Device> make_scripted(const DeviceContext& c) {
   return std::make_unique<hw::ScriptedFinger>(c.scenario.make_trajectory(c.finger), c.scenario.fingers()[c.finger].limits);
 }
 
-// One finger's recorded hip and gimbal, row n at servo tick n (tools/app/replay.cpp reads them).
+// One finger's recorded hip and gimbal, row n at servo tick n (app/replay.cpp reads them).
 // The finger's script still runs alongside, its output discarded, as in `graspsim replay`: a
 // script that watches the run, or Lua's math.random, sees what it saw in the recording.
 std::unique_ptr<hw::Device> make_replay(const DeviceContext& c) {

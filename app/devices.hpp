@@ -56,7 +56,7 @@ struct DeviceKind {
   std::function<bool(const std::string& arg)> waits_for_graspsim = {};
   // Whether the device runs the finger's script itself (scripted: it is the script; replay: it
   // runs it alongside; sim-phantom: the hand follows it). false (udp, phantom): the run loop runs
-  // it alongside (RunOptions::script_alongside).
+  // it alongside (RunOptions::Devices::script_alongside).
   bool runs_script = true;
   // ARG names a file the device reads (replay:TRACE.h5): the run's output may not be that file.
   bool reads_file = false;

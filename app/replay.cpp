@@ -4,14 +4,12 @@
 
 #include <algorithm>
 #include <cmath>
-#include <filesystem>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <sstream>
 
 #include "graspsim/hw/replay_device.hpp"
-#include "graspsim/hw/sample_clock.hpp"
-#include "graspsim/hw/sample_counter.hpp"
 #include "graspsim/recordings/trace_reader.hpp"
 #include "graspsim/recordings/trace_recorder.hpp"
 
@@ -60,8 +58,7 @@ std::vector<hw::Vec3> read_vec3(const std::string& trace, const std::string& pat
 // A device's recorded samples, row n at servo tick n, in its own frame, with their own clock
 // and the recorded pacing (so the run loop rewrites the same /devices row). The finger's script
 // still runs alongside, as for ReplayDevice.
-class DeviceRowsReplay final : public hw::Device, public hw::SampleClock, public hw::SampleCounter,
-                               public RecordedPacing {
+class DeviceRowsReplay final : public hw::Device {
  public:
   DeviceRowsReplay(const RecordedDeviceRows& rows, hw::DeviceLimits limits, std::string source,
                    std::unique_ptr<hw::Trajectory> script)
@@ -82,9 +79,11 @@ class DeviceRowsReplay final : public hw::Device, public hw::SampleClock, public
   }
   hw::DeviceLimits limits() const override { return limits_; }
   std::string describe() const override { return "replay of " + source_; }
+  bool has_sample_clock() const override { return true; }
   double sample_time() const override { return time_; }
   std::int64_t sample_sequence() const override { return rows_.sequence[row_]; }
   std::int64_t new_samples() const override { return rows_.new_samples[row_]; }
+  bool has_recorded_pacing() const override { return true; }
   bool recorded_overrun() const override { return overrun_; }
 
  protected:
@@ -100,7 +99,7 @@ class DeviceRowsReplay final : public hw::Device, public hw::SampleClock, public
   bool overrun_ = false;
 };
 
-// The `mapping` attribute run.cpp writes: "identity ..." or "scale S; offset X Y Z m; rotation R P Y rad"
+// The `mapping` attribute device_tables.cpp writes: "identity ..." or "scale S; offset X Y Z m; rotation R P Y rad"
 // with every number at 17 significant digits, so it parses back to the same doubles.
 bool parse_mapping(const std::string& text, hw::WorkspaceMapping& m) {
   if (text.rfind("identity", 0) == 0) return false;
@@ -178,9 +177,17 @@ ReplayPlan load(const std::string& trace, const ReplayOptions& options) {
                       std::to_string(recordings::kSchemaVersion) + ")");
   }
   plan.status = required_string(trace, "status");
-  // The run's force ramp (absent: 0, no ramp): rendered forces again.
-  if (recordings::has_attribute(trace, "/", "force_ramp"))
-    plan.force_ramp = recordings::read_double_attribute(trace, "/", "force_ramp");
+  // A trace whose run scaled its rendered forces by a start ramp of its own (root `force_ramp`
+  // > 0, s): the one force ramp is a device's force safety, which a run does not record, so the
+  // replay renders the demand clamped, and its /servo force differs from the recording's for
+  // the first force_ramp seconds. The engine never saw that ramp.
+  if (recordings::has_attribute(trace, "/", "force_ramp")) {
+    const double ramp = recordings::read_double_attribute(trace, "/", "force_ramp");
+    if (ramp > 0.0)
+      plan.notes.push_back("the recording scaled rendered forces by a start ramp of " + std::to_string(ramp) +
+                           " s outside force safety, which this replay does not: /servo force differs until then "
+                           "(the engine is unchanged)");
+  }
   plan.scenario_path = required_string(trace, "scenario_path");
   plan.scenario_source_hash = required_string(trace, "scenario_source_hash");
   const std::string source = required_string(trace, "scenario_source");
@@ -336,16 +343,16 @@ RunOptions ReplayPlan::run_options(const std::string& out) const {
   RunOptions options;
   options.out = out;
   options.overrides = overrides;
-  options.max_ticks = recorded_ticks;
-  options.force_ramp = force_ramp;
+  options.stop.max_ticks = recorded_ticks;
   options.attributes.emplace_back("replay_of", replay_of());
+  options.inputs.push_back({trace, "the trace replayed"});
   for (const RecordedFinger& r : fingers) {
-    options.record_devices.push_back(r.device.has_value());
+    options.devices.record.push_back(r.device.has_value());
     // A device table without the counter columns: the replay writes none either, so that it can
     // equal the recording (compare refuses tables whose columns differ).
-    if (r.device && !r.device->counted) options.device_counters = false;
+    if (r.device && !r.device->counted) options.devices.counters = false;
   }
-  options.make_device = [this](std::size_t f) -> std::unique_ptr<hw::Device> {
+  options.devices.make = [this](std::size_t f) -> std::unique_ptr<hw::Device> {
     const std::string& name = scenario->model().fingers[f].name;
     if (const auto& d = fingers[f].device) {
       // The device's own samples through the recorded mapping: the same world hip, bit for bit.
@@ -359,6 +366,31 @@ RunOptions ReplayPlan::run_options(const std::string& out) const {
                                               scenario->make_trajectory(f));
   };
   return options;
+}
+
+std::string default_replay_out(const std::string& trace) {
+  return std::filesystem::path(trace).stem().string() + ".replay.h5";
+}
+
+std::int64_t ReplayOutcome::state_hashes() const {
+  if (comparison)
+    for (const auto& d : comparison->datasets)
+      if (d.path == "physics/state_hash") return d.elements;
+  return 0;
+}
+
+ReplayOutcome run_replay(const ReplayPlan& plan, const RunOptions& options) {
+  ReplayOutcome outcome;
+  outcome.run = run_scenario(*plan.scenario, options);
+  if (outcome.run.not_started) return outcome;
+  try {
+    recordings::CompareOptions bitwise;
+    bitwise.bitwise = true;
+    outcome.comparison = recordings::compare_traces(plan.trace, outcome.run.trace_path, bitwise);
+  } catch (const recordings::TraceError& e) {
+    outcome.compare_error = e.what();
+  }
+  return outcome;
 }
 
 ReplayPlan load_replay(const std::string& trace, const ReplayOptions& options) {

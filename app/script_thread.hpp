@@ -106,9 +106,9 @@ struct ScriptThreadOptions {
   std::int64_t physics_divisor = 60; // D: servo ticks per physics period
   std::int64_t end_tick = 0;         // the run's servo ticks: samples are computed up to end_tick + capacity
   bool view = false;                 // some trajectory reads the view (Scenario::uses_view)
-  // Tests only (a paced run on a fake clock, which outruns any thread): the loop waits for a
-  // sample that the script thread can still compute instead of holding. Never with a hand on a
-  // device: a slow script would then stall the loop.
+  // RunSeams::wait_for_script (a paced run on a fake clock, which outruns any thread): the loop
+  // waits for a sample that the script thread can still compute instead of holding. Never with a
+  // hand on a device: a slow script would then stall the loop.
   bool wait_for_samples = false;
 };
 

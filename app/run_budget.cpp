@@ -10,18 +10,11 @@
 #include <fstream>
 #include <sstream>
 
+#include "graspsim/recordings/device_recorder.hpp"
 #include "graspsim/recordings/trace_recorder.hpp"
 
 namespace graspsim::app {
 namespace {
-
-// One /devices/<finger> row as run.cpp's device_columns declares it: tick and buttons (int64),
-// time, device_time, position, gimbal and force (11 float64) and overrun (int8), 14 values in
-// 105 bytes; the counters sequence and new_samples (int64) add 2 values and 16 bytes.
-// tests/e2e/test_run_budget.cpp checks it against a written table.
-recordings::RowSize device_row(bool counters) {
-  return counters ? recordings::RowSize{16, 121} : recordings::RowSize{14, 105};
-}
 
 std::string bytes_text(double bytes) {
   const char* units[] = {"bytes", "kB", "MB", "GB", "TB", "PB", "EB"};
@@ -39,12 +32,12 @@ RunFootprint estimate_footprint(const scripting::Scenario& scenario, const RunOp
   RunFootprint out;
   const double ticks = std::round(scenario.duration() * model.rates.servo);
   out.servo_ticks = static_cast<std::int64_t>(ticks);
-  if (options.max_ticks >= 0) out.servo_ticks = std::min(out.servo_ticks, options.max_ticks);
+  if (options.stop.max_ticks >= 0) out.servo_ticks = std::min(out.servo_ticks, options.stop.max_ticks);
   const double run = static_cast<double>(out.servo_ticks);
   const Divisors d = divisors(model.rates);
   const double flush = static_cast<double>(flush_interval_ticks(model));
   const auto block = [&](double divisor) {
-    return options.block_rows > 0 ? static_cast<double>(options.block_rows) : std::ceil(flush / divisor);
+    return options.trace.block_rows > 0 ? static_cast<double>(options.trace.block_rows) : std::ceil(flush / divisor);
   };
   const recordings::TraceRecorder::Rows rows = recordings::TraceRecorder::row_sizes(model);
   const auto table = [&](std::string name, recordings::RowSize row, double divisor) {
@@ -53,9 +46,9 @@ RunFootprint estimate_footprint(const scripting::Scenario& scenario, const RunOp
   table("/servo", rows.servo, 1.0);
   table("/haptic", rows.haptic, static_cast<double>(d.haptic));
   table("/physics", rows.physics, static_cast<double>(d.physics));
-  for (std::size_t f = 0; f < options.record_devices.size() && f < model.fingers.size(); ++f)
-    if (options.record_devices[f]) table("/devices/" + model.fingers[f].name, device_row(options.device_counters), 1.0);
-  const double pool = options.background_writer ? 4.0 : 1.0;   // TraceTable's blocks (trace_writer.cpp)
+  for (std::size_t f = 0; f < options.devices.record.size() && f < model.fingers.size(); ++f)
+    if (options.devices.record[f]) table("/devices/" + model.fingers[f].name, recordings::DeviceRecorder::row_size(options.devices.counters), 1.0);
+  const double pool = options.trace.background_writer ? 4.0 : 1.0;   // TraceTable's blocks (trace_writer.cpp)
   double largest = -1.0;
   for (const TableFootprint& t : out.tables) {
     const double memory = pool * t.block_rows * static_cast<double>(t.values) * 8.0 + t.block_rows * static_cast<double>(t.bytes);
@@ -113,7 +106,7 @@ std::string refusal(const RunFootprint& need, const MachineRoom& room, int compr
 
 std::string check_run_fits(const scripting::Scenario& scenario, const RunOptions& options, std::string* warning) {
   const std::string out = options.out.empty() ? scenario.name() + ".h5" : options.out;
-  return refusal(estimate_footprint(scenario, options), machine_room(out), options.compression, warning);
+  return refusal(estimate_footprint(scenario, options), machine_room(out), options.trace.compression, warning);
 }
 
 }  // namespace graspsim::app

@@ -24,11 +24,6 @@ inline constexpr double kStallTimeout = 0.02;
 // (a few ms on a shared VM).
 inline constexpr double kLagLimit = 0.1;
 
-// The force ramp of graspsim run with a real device (s, RunOptions::force_ramp): rendered
-// forces rise linearly from 0 over the first half second, slower than a hand's reflex, so a
-// device that starts inside an object (or a wrong mapping) pushes gently before it pushes fully.
-inline constexpr double kForceRamp = 0.5;
-
 class MonotonicClock {
  public:
   virtual ~MonotonicClock() = default;
