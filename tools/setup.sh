@@ -1,9 +1,15 @@
-# Shared set-up for tools/graspsim and tools/check: install the Debian packages that are
-# missing, configure once, build incrementally. Sourced, not run; idempotent.
-# Environment: GRASPSIM_BUILD_DIR (default build), GRASPSIM_BUILD_TYPE (default Release).
+# Shared set-up for tools/graspsim, tools/check and tools/fuzz: install the Debian packages that
+# are missing, configure once, build incrementally. Sourced, not run; idempotent.
+# Environment: GRASPSIM_BUILD_DIR (default build), GRASPSIM_BUILD_TYPE (default Release),
+# GRASPSIM_SANITIZE_BUILD_DIR (default build-sanitize).
 
 graspsim_root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 graspsim_build=${GRASPSIM_BUILD_DIR:-$graspsim_root/build}
+graspsim_cmake_env=()    # e.g. CC=clang CXX=clang++, for the first configure only
+# Extra -D options, for the first configure only. The main build (GCC) builds no Clang twin of
+# graspsim: tools/check compares the sanitizer build's graspsim, a Clang build, with this build's
+# instead (README.md, "Which build checks what").
+graspsim_cmake_args=(-DGRASPSIM_COMPILER_TWIN=OFF)
 
 # Everything graspsim needs from Debian 12, and nothing else. hdf5-tools gives h5dump and
 # h5ls for looking into traces.
@@ -11,9 +17,11 @@ graspsim_packages=(
   g++ make cmake pkg-config git
   libeigen3-dev libfcl-dev liblua5.4-dev libhdf5-dev catch2
   hdf5-tools
-  clang                             # the Clang twin (tests/golden/test_compiler_twin.cpp)
   python3-h5py python3-matplotlib   # tools/plot_trace.py; h5py also reads crash-cut traces in
                                     # SWMR mode in tests/e2e/test_crash.cpp
+  clang libclang-rt-dev             # the Clang twin (tests/golden/test_compiler_twin.cpp), the
+                                    # sanitizer build (its runtimes) and libFuzzer (README.md
+                                    # "Sanitizers and fuzzing")
 )
 
 graspsim_install_missing() {
@@ -52,8 +60,8 @@ graspsim_build() {
   mkdir -p "$graspsim_build" && : >"$log"
   if [ ! -f "$graspsim_build/CMakeCache.txt" ]; then
     echo "graspsim: first build, in $graspsim_build (a few minutes; log: $log)" >&2
-    cmake -S "$graspsim_root" -B "$graspsim_build" \
-      -DCMAKE_BUILD_TYPE="${GRASPSIM_BUILD_TYPE:-Release}" >>"$log" 2>&1 \
+    env "${graspsim_cmake_env[@]}" cmake -S "$graspsim_root" -B "$graspsim_build" \
+      -DCMAKE_BUILD_TYPE="${GRASPSIM_BUILD_TYPE:-Release}" "${graspsim_cmake_args[@]}" >>"$log" 2>&1 \
       || { cat "$log" >&2; echo "graspsim: configuring failed (log: $log)" >&2; return 1; }
   fi
   local targets=()
@@ -64,6 +72,18 @@ graspsim_build() {
     echo "graspsim: build failed (log: $log)" >&2
     return 1
   fi
+}
+
+# graspsim_use_sanitize_build: later graspsim_build calls build the sanitizer build instead, a
+# Clang build with AddressSanitizer, UndefinedBehaviorSanitizer and the fuzzers (GRASPSIM_SANITIZE
+# in CMakeLists.txt), without the Debug twin the main build tests. Its GCC-vs-Clang test compares
+# its graspsim with the main build's (which tools/check builds first), so no Clang twin is built.
+graspsim_use_sanitize_build() {
+  local main_build=${GRASPSIM_BUILD_DIR:-$graspsim_root/build}
+  graspsim_build=${GRASPSIM_SANITIZE_BUILD_DIR:-$graspsim_root/build-sanitize}
+  graspsim_cmake_env=(CC=clang CXX=clang++)
+  graspsim_cmake_args=(-DGRASPSIM_SANITIZE=ON -DGRASPSIM_TWIN_BUILD=OFF
+                       -DGRASPSIM_COMPILER_TWIN_CLI="$main_build/tools/graspsim")
 }
 
 # graspsim_setup [TARGET...]
