@@ -135,6 +135,8 @@ ImplicitStep::ImplicitStep(const Model& model) {
   w1_.resize(n);
   vq_.resize(n);
   wq_.resize(n);
+  v_mean_.resize(n);
+  w_mean_.resize(n);
   second_order_.resize(n);
   signature_.resize(n);
 }
@@ -225,6 +227,10 @@ void ImplicitStep::solve(const Model& model, const State& state, const std::vect
     if (bdf2) {
       const double third = 1.0 / 3.0;
       for (int b : current_) {
+        const BodyState& bs = state.bodies[b];
+        v_mean_[b] = (bs.position - bs.position_before_step) / h;
+        const Eigen::AngleAxisd turn(bs.rotation * bs.rotation_before_step.transpose());
+        w_mean_[b] = (turn.angle() / h) * turn.axis();
         vq_[b] = third * (4.0 * v0[b] - state.bodies[b].velocity_before_step);
         wq_[b] = third * (4.0 * w0[b] - state.bodies[b].angular_velocity_before_step);
       }
@@ -232,7 +238,7 @@ void ImplicitStep::solve(const Model& model, const State& state, const std::vect
       // joins the force at the start (in a sliding point only its normal part counts).
       for (int i : current_couplings_) {
         const Coupling& c = couplings[i];
-        const Vec3 u = relative_velocity(state, c, history.v_mean, history.w_mean);
+        const Vec3 u = relative_velocity(state, c, v_mean_, w_mean_);
         const double u_n = c.normal.dot(u);
         start_force_[i] = c.force - (third * h) * (c.k_n * u_n * c.normal + c.k_t * (u - u_n * c.normal));
       }

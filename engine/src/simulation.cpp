@@ -62,8 +62,6 @@ Simulation::Simulation(Model model)
   external_torque_.resize(n);
   history_.order = model_.implicit_order;
   history_.valid.resize(n);
-  history_.v_mean.resize(n);
-  history_.w_mean.resize(n);
   history_.signature.resize(n);
   history_.steps.resize(n);
   finger_point_.resize(model_.fingers.size());

@@ -91,15 +91,10 @@ void Simulation::implicit_solve(double pitch_change) {
     w0_[b] = bs.angular_velocity + gyroscopic_change(bp, model_.gyroscopic, bs, h);
     external_force_[b] = bs.window_force * per_tick + bp.mass * model_.gravity;
     external_torque_[b] = bs.window_torque * per_tick;
-    // The last step's displacement rates, for BDF2, from a body stepped at the last physics tick.
+    // What BDF2 needs to know of the last step: whether the body took it at the last physics tick.
     history_.valid[b] = !bs.asleep && bs.stepped_at >= 0 && bs.stepped_at + divisors_.physics == state_.tick;
     history_.signature[b] = bs.island_signature;
     history_.steps[b] = bs.island_steps;
-    if (history_.valid[b]) {
-      history_.v_mean[b] = (bs.position - bs.position_before_step) / h;
-      const Eigen::AngleAxisd turn(bs.rotation * bs.rotation_before_step.transpose());
-      history_.w_mean[b] = (turn.angle() / h) * turn.axis();
-    }
   }
   // The fingers' forces enter through their couplings: what is left of the bodies' windows is
   // what fingers pushed that are no longer in contact, and the torque of each finger's force
@@ -175,9 +170,9 @@ void Simulation::implicit_body_step(int b, TickRecord& record) {
   rec.torque = torque;
   const Vec3 v_start = bs.velocity, w_start = bs.angular_velocity;
   if (implicit_.second_order(b)) {
-    const Vec3 v_mean = history_.v_mean[b], w_mean = history_.w_mean[b];
     mark_stepped(bs);
-    move_body_bdf2(bs, implicit_.velocity(b), implicit_.angular_velocity(b), v_mean, w_mean, h);
+    move_body_bdf2(bs, implicit_.velocity(b), implicit_.angular_velocity(b), implicit_.mean_velocity(b),
+                   implicit_.mean_angular_velocity(b), h);
   } else {
     bs.angular_velocity = w0;
     mark_stepped(bs);

@@ -18,8 +18,6 @@ namespace graspsim {
 struct StepHistory {
   int order = 1;                            // 1: backward Euler everywhere; 2: BDF2 where the history allows
   std::vector<std::uint8_t> valid;          // stepped at the last physics tick (awake since)
-  std::vector<Vec3> v_mean;                 // m/s, world: (x0 - x_-1) / h, the last step's displacement rate
-  std::vector<Vec3> w_mean;                 // rad/s, world: the last step's rotation vector / h
   std::vector<std::uint64_t> signature;     // its island's couplings and their modes at the last step
   std::vector<int> steps;                   // 1: physics steps in a row its island kept that signature
 };
@@ -65,6 +63,10 @@ class ImplicitStep {
   // Whether the body's island took the BDF2 step, and its signature (couplings and modes) now.
   bool second_order(int body) const { return second_order_[body] != 0; }
   std::uint64_t signature(int body) const { return signature_[body]; }
+  // Under BDF2, the last step's displacement rates: (x0 - x_-1) / h, m/s, and its rotation
+  // vector / h, rad/s (world), from BodyState's pose before the step.
+  const Vec3& mean_velocity(int body) const { return v_mean_[body]; }
+  const Vec3& mean_angular_velocity(int body) const { return w_mean_[body]; }
 
   // Most active-set rounds per island: each round changes at least one point's mode, hold ->
   // slip -> off, never back, so the set settles; the cap bounds the cost of a rare long cascade.
@@ -108,6 +110,8 @@ class ImplicitStep {
   std::vector<Vec3> u0_;                    // m/s, world, per coupling: relative velocity at the start
   std::vector<Vec3> start_force_;           // N, world, per coupling: `force`, less h/3 K u_mean under BDF2
   std::vector<Vec3> vq_, wq_;               // m/s, rad/s, per body: q0, or q^ under BDF2
+  std::vector<Vec3> v_mean_, w_mean_;       // m/s, rad/s, per body under BDF2: the last step's
+                                            //    displacement rates
   std::vector<std::uint8_t> second_order_;  // per body: its island took the BDF2 step
   std::vector<std::uint64_t> signature_;    // per body: its island's couplings and modes
   std::vector<int> current_;                // the island being solved: its bodies, couplings
