@@ -1,42 +1,13 @@
 // The linearly implicit step (backward Euler on each island's velocities, linearised couplings)
 // and its active set of unilateral, frictional points.
 #include "graspsim/engine/implicit_step.hpp"
+#include "graspsim/engine/dense_solve.hpp"
 
 #include <algorithm>
 #include <cmath>
 
 namespace graspsim {
 namespace {
-
-// Solves A x = b in place by Gaussian elimination with partial pivoting (`a` row-major n x n,
-// overwritten; `b` becomes x). The island's matrix M + h (h K + C) is positive definite but for
-// sliding points, whose friction force follows their normal force, mu t n^T, which makes it
-// unsymmetric; pivoting keeps the elimination backward stable either way. A zero or non-finite
-// pivot leaves `b` non-finite, which the step's divergence check sees.
-void lu_solve(double* a, double* b, int n) {
-  for (int j = 0; j < n; ++j) {
-    int p = j;
-    for (int i = j + 1; i < n; ++i) {
-      if (std::abs(a[i * n + j]) > std::abs(a[p * n + j])) p = i;
-    }
-    if (p != j) {
-      for (int k = j; k < n; ++k) std::swap(a[j * n + k], a[p * n + k]);
-      std::swap(b[j], b[p]);
-    }
-    const double pivot = a[j * n + j];
-    for (int i = j + 1; i < n; ++i) {
-      const double l = a[i * n + j] / pivot;
-      if (l == 0.0) continue;
-      for (int k = j + 1; k < n; ++k) a[i * n + k] -= l * a[j * n + k];
-      b[i] -= l * b[j];
-    }
-  }
-  for (int i = n - 1; i >= 0; --i) {
-    double s = b[i];
-    for (int k = i + 1; k < n; ++k) s -= a[i * n + k] * b[k];
-    b[i] = s / a[i * n + i];
-  }
-}
 
 // G = h K + C of a coupling in its mode (3x3, world): the force's change per unit of relative
 // velocity at the end of the step. While sliding along unit t (tangential, the way the held
@@ -71,41 +42,48 @@ struct Response {
   enum class Shape : std::uint8_t { kIsotropic, kRankOne, kGeneral } shape;
   double g = 0.0;   // kIsotropic: N s/m
   Vec3 a, b;        // kRankOne: G = a b^T
-  Mat3 full;        // every shape: G
+  Mat3 full;        // kGeneral: G
+
+  Vec3 times(const Vec3& v) const {   // G v
+    if (shape == Shape::kIsotropic) return g * v;
+    if (shape == Shape::kRankOne) return b.dot(v) * a;
+    return full * v;
+  }
 };
 
-void add_block(double* m, int n, int row, int col, const Response& g, const Vec3& r_x, const Vec3& r_y, double s) {
-  Eigen::Map<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>> a(m, n, n);
+template <int N>
+void add_block(double* m, int size, int row, int col, const Response& g, const Vec3& r_x, const Vec3& r_y, double s) {
+  constexpr int kSize = N > 0 ? N : Eigen::Dynamic;
+  Eigen::Map<Eigen::Matrix<double, kSize, kSize, Eigen::RowMajor>> a(m, N > 0 ? N : size, N > 0 ? N : size);
   if (g.shape == Response::Shape::kIsotropic) {
     const double sg = s * g.g;
     const Mat3 sy = skew(r_y), sx = skew(r_x);
-    a.block<3, 3>(row, col).diagonal().array() += sg;
-    a.block<3, 3>(row, col + 3) -= sg * sy;
-    a.block<3, 3>(row + 3, col) += sg * sx;
+    a.template block<3, 3>(row, col).diagonal().array() += sg;
+    a.template block<3, 3>(row, col + 3) -= sg * sy;
+    a.template block<3, 3>(row + 3, col) += sg * sx;
     Mat3 sxsy = r_y * r_x.transpose();
     sxsy.diagonal().array() -= r_x.dot(r_y);
-    a.block<3, 3>(row + 3, col + 3) -= sg * sxsy;
+    a.template block<3, 3>(row + 3, col + 3) -= sg * sxsy;
     return;
   }
   if (g.shape == Response::Shape::kRankOne) {
     Eigen::Matrix<double, 6, 1> ja, jb;
     ja << g.a, r_x.cross(g.a);
     jb << g.b, r_y.cross(g.b);
-    a.block<6, 6>(row, col) += (s * ja) * jb.transpose();
+    a.template block<6, 6>(row, col) += (s * ja) * jb.transpose();
     return;
   }
   const Mat3 sx = skew(r_x);
   const Mat3 gs = g.full * skew(r_y);
-  a.block<3, 3>(row, col) += s * g.full;
-  a.block<3, 3>(row, col + 3) -= s * gs;
-  a.block<3, 3>(row + 3, col) += s * (sx * g.full);
-  a.block<3, 3>(row + 3, col + 3) -= s * (sx * gs);
+  a.template block<3, 3>(row, col) += s * g.full;
+  a.template block<3, 3>(row, col + 3) -= s * gs;
+  a.template block<3, 3>(row + 3, col) += s * (sx * g.full);
+  a.template block<3, 3>(row + 3, col + 3) -= s * (sx * gs);
 }
 
 // The coupling's response G (response()) with its shape for add_block.
 Response response_shape(const Coupling& c, CouplingMode mode, const Vec3& slide, double h) {
   Response r;
-  r.full = response(c, mode, slide, h);
   const double reach = h + c.lead;   // s
   const double g_n = reach * c.k_n + c.c_n;
   if (mode == CouplingMode::kSlip) {
@@ -117,6 +95,7 @@ Response response_shape(const Coupling& c, CouplingMode mode, const Vec3& slide,
     r.g = g_n;
   } else {
     r.shape = Response::Shape::kGeneral;
+    r.full = response(c, mode, slide, h);
   }
   return r;
 }
@@ -138,6 +117,7 @@ ImplicitStep::ImplicitStep(const Model& model) {
   v_mean_.resize(n);
   w_mean_.resize(n);
   second_order_.resize(n);
+  iso_.resize(n);
   signature_.resize(n);
 }
 
@@ -170,6 +150,7 @@ void ImplicitStep::solve(const Model& model, const State& state, const std::vect
                          const std::vector<Vec3>& torque, const std::vector<std::uint8_t>& axis_active,
                          const std::vector<Vec3>& axis, const std::vector<Vec3>& axis_point,
                          const std::vector<double>& axis_rate, const StepHistory& history, double h) {
+  const Inputs in{model, state, couplings, force, torque, axis_active, axis, axis_point, axis_rate};
   const int nb = static_cast<int>(model.bodies.size());
   mode_.assign(couplings.size(), CouplingMode::kHold);
   slide_.assign(couplings.size(), Vec3::Zero());
@@ -242,7 +223,7 @@ void ImplicitStep::solve(const Model& model, const State& state, const std::vect
         const double u_n = c.normal.dot(u);
         start_force_[i] = c.force - (third * h) * (c.k_n * u_n * c.normal + c.k_t * (u - u_n * c.normal));
       }
-      solve_island(model, state, couplings, force, torque, axis_active, axis, axis_point, axis_rate, 2.0 * third * h);
+      solve_island(in, 2.0 * third * h);
       bdf2 = island_signature(couplings) == last;
     }
     if (!bdf2) {
@@ -251,9 +232,9 @@ void ImplicitStep::solve(const Model& model, const State& state, const std::vect
         wq_[b] = w0[b];
       }
       for (int i : current_couplings_) start_force_[i] = couplings[i].force;
-      solve_island(model, state, couplings, force, torque, axis_active, axis, axis_point, axis_rate, h);
+      solve_island(in, h);
     }
-    const std::uint64_t signature = island_signature(couplings);
+    const std::uint64_t signature = bdf2 ? last : island_signature(couplings);
     for (int b : current_) {
       second_order_[b] = bdf2 ? 1 : 0;
       signature_[b] = signature;
@@ -265,23 +246,22 @@ void ImplicitStep::solve(const Model& model, const State& state, const std::vect
 // decided before any point letting go: a held point stops the body dead, and the torque that takes
 // can lift other points that a sliding body keeps on the floor. `h` is the step's implicit
 // coefficient: the step for backward Euler, 2/3 of it for BDF2.
-void ImplicitStep::solve_island(const Model& model, const State& state, const std::vector<Coupling>& couplings,
-                                const std::vector<Vec3>& force, const std::vector<Vec3>& torque,
-                                const std::vector<std::uint8_t>& axis_active, const std::vector<Vec3>& axis,
-                                const std::vector<Vec3>& axis_point, const std::vector<double>& axis_rate,
-                                double h) {
+void ImplicitStep::solve_island(const Inputs& in, double h) {
+  const State& state = in.state;
+  const std::vector<Coupling>& couplings = in.couplings;
   for (int i : current_couplings_) {
     mode_[i] = CouplingMode::kHold;
     slide_[i].setZero();
     solved_[i].setZero();
   }
   for (int round = 0; round < kMaxRounds; ++round) {
-    assemble_and_solve(model, state, couplings, vq_, wq_, force, torque, axis_active, axis, axis_point, axis_rate, h);
+    assemble_and_solve(in, h);
     bool slipped = false, released = false;
     for (int i : current_couplings_) {
       const Coupling& c = couplings[i];
       const Vec3 u1 = relative_velocity(state, c, v1_, w1_);
-      solved_[i] = constant_force(c, start_force_[i], mode_[i], u0_[i], slide_[i]) - response(c, mode_[i], slide_[i], h) * u1;
+      solved_[i] = constant_force(c, start_force_[i], mode_[i], u0_[i], slide_[i]) -
+                   response_shape(c, mode_[i], slide_[i], h).times(u1);
       if (c.mu < 0.0 || mode_[i] != CouplingMode::kHold) continue;
       const double f_n = c.normal.dot(solved_[i]);
       const Vec3 f_t = solved_[i] - f_n * c.normal;
@@ -310,40 +290,47 @@ void ImplicitStep::solve_island(const Model& model, const State& state, const st
   }
 }
 
-// FNV-1a over the island's bodies and its couplings' identities, whether each pushed at the start
+// A hash of the island's bodies and its couplings' identities, whether each pushed at the start
 // of the step, and their modes: equal from one step to the next only while the same points act on
 // the same bodies in the same way. (A floor point the step reaches is a coupling before the body
-// arrives; its arrival is the step its force starts to push.)
+// arrives; its arrival is the step its force starts to push.) Word by word, FNV-1a's multiply
+// with an xor-shift after it, so that every bit of a word reaches the high and the low bits.
 std::uint64_t ImplicitStep::island_signature(const std::vector<Coupling>& couplings) const {
   std::uint64_t hash = 14695981039346656037ull;
-  const auto mix = [&hash](std::int64_t value) {
-    for (int byte = 0; byte < 8; ++byte) {
-      hash ^= static_cast<std::uint64_t>(value >> (8 * byte)) & 0xffu;
-      hash *= 1099511628211ull;
-    }
+  const auto mix = [&hash](std::uint64_t word) {
+    hash = (hash ^ word) * 1099511628211ull;
+    hash ^= hash >> 29;
   };
-  for (int b : current_) mix(b);
+  const auto low = [](int value) { return static_cast<std::uint64_t>(static_cast<std::uint32_t>(value)); };
+  for (int b : current_) mix(low(b));
   for (int i : current_couplings_) {
     const Coupling& c = couplings[i];
-    mix(static_cast<std::int64_t>(c.source));
-    mix(c.slot);
-    mix(c.a);
-    mix(c.b);
-    mix(c.normal.dot(c.force) > 0.0 ? 1 : 0);
-    mix(static_cast<std::int64_t>(mode_[i]));
+    const std::uint64_t pushed = c.normal.dot(c.force) > 0.0 ? 1 : 0;
+    mix(static_cast<std::uint64_t>(c.source) | static_cast<std::uint64_t>(mode_[i]) << 8 | pushed << 16 | low(c.slot) << 32);
+    mix(low(c.a) | low(c.b) << 32);
   }
   return hash == 0 ? 1 : hash;   // 0 means no history
 }
 
-void ImplicitStep::assemble_and_solve(const Model& model, const State& state,
-                                      const std::vector<Coupling>& couplings, const std::vector<Vec3>& v0,
-                                      const std::vector<Vec3>& w0, const std::vector<Vec3>& force,
-                                      const std::vector<Vec3>& torque, const std::vector<std::uint8_t>& axis_active,
-                                      const std::vector<Vec3>& axis, const std::vector<Vec3>& axis_point,
-                                      const std::vector<double>& axis_rate, double h) {
+void ImplicitStep::assemble_and_solve(const Inputs& in, double h) {
   int constraints = 0;
-  for (int b : current_) constraints += axis_active[b] ? 1 : 0;
+  for (int b : current_) constraints += in.axis_active[b] ? 1 : 0;
   const int n = 6 * static_cast<int>(current_.size()) + constraints;
+  switch (n) {
+    case 6: return assemble_and_solve_n<6>(in, n, h);   // one body, no axis rule
+    default: return assemble_and_solve_n<0>(in, n, h);
+  }
+}
+
+// The island's system from q^ = (vq_, wq_), the couplings in their modes, and the axis
+// constraints; solved into (v1_, w1_).
+template <int N>
+void ImplicitStep::assemble_and_solve_n(const Inputs& in, int size, double h) {
+  const int n = N > 0 ? N : size;
+  const Model& model = in.model;
+  const State& state = in.state;
+  const std::vector<Vec3>& v0 = vq_;
+  const std::vector<Vec3>& w0 = wq_;
   double* m = matrix_.data();
   double* r = rhs_.data();
   std::fill(m, m + n * n, 0.0);
@@ -353,8 +340,8 @@ void ImplicitStep::assemble_and_solve(const Model& model, const State& state,
     const BodyParams& bp = model.bodies[b];
     const Mat3& R = state.bodies[b].rotation;
     const Mat3 inertia = R * bp.inertia.asDiagonal() * R.transpose();   // kg m^2, world
-    const Vec3 p = bp.mass * v0[b] + h * force[b];
-    const Vec3 l = inertia * w0[b] + h * torque[b];
+    const Vec3 p = bp.mass * v0[b] + h * in.force[b];
+    const Vec3 l = inertia * w0[b] + h * in.torque[b];
     for (int i = 0; i < 3; ++i) {
       m[(o + i) * n + o + i] = bp.mass;
       for (int j = 0; j < 3; ++j) m[(o + 3 + i) * n + o + 3 + j] = inertia(i, j);
@@ -362,20 +349,33 @@ void ImplicitStep::assemble_and_solve(const Model& model, const State& state,
       r[o + 3 + i] = l[i];
     }
   }
-  // Each coupling: h J^T G J into the matrix, h J^T (force + C u0) into the right side.
+  // Each coupling: h J^T G J into the matrix, h J^T (force + C u0) into the right side. An
+  // isotropic point's block on its own body, g [[I, -S(r)], [S(r), -S(r)^2]], is linear in g, g r
+  // and g S(r)^2 = g (r r^T - (r . r) I): summed over the body's points first, and added once.
+  for (int b : current_) iso_[local_[b]] = IsotropicSum{};
+  const auto own_block = [&](int body, const Response& g, const Vec3& arm) {
+    const int o = 6 * local_[body];
+    if (g.shape != Response::Shape::kIsotropic) return add_block<N>(m, n, o, o, g, arm, arm, h);
+    IsotropicSum& sum = iso_[local_[body]];
+    sum.g += g.g;
+    sum.g_arm += g.g * arm;
+    Mat3 arm2 = arm * arm.transpose();
+    arm2.diagonal().array() -= arm.dot(arm);
+    sum.g_arm2 += g.g * arm2;
+  };
   for (int i : current_couplings_) {
-    const Coupling& c = couplings[i];
+    const Coupling& c = in.couplings[i];
     if (mode_[i] == CouplingMode::kOff) continue;
     const Response g = response_shape(c, mode_[i], slide_[i], h);
     Vec3 fc = constant_force(c, start_force_[i], mode_[i], u0_[i], slide_[i]);
-    if (c.a < 0) fc += g.full * c.world_velocity;   // the world side moves on: u1 = J q1 - v_world
+    if (c.a < 0) fc += g.times(c.world_velocity);   // the world side moves on: u1 = J q1 - v_world
     const bool in_b = c.b >= 0 && island_of_[c.b] >= 0;
     const bool in_a = c.a >= 0 && island_of_[c.a] >= 0;
     const Vec3 r_b = in_b ? Vec3(c.point - state.bodies[c.b].position) : Vec3::Zero();
     const Vec3 r_a = in_a ? Vec3(c.point - state.bodies[c.a].position) : Vec3::Zero();
     if (in_b) {
       const int o = 6 * local_[c.b];
-      add_block(m, n, o, o, g, r_b, r_b, h);
+      own_block(c.b, g, r_b);
       const Vec3 t = r_b.cross(fc);
       for (int k = 0; k < 3; ++k) {
         r[o + k] += h * fc[k];
@@ -384,7 +384,7 @@ void ImplicitStep::assemble_and_solve(const Model& model, const State& state,
     }
     if (in_a) {
       const int o = 6 * local_[c.a];
-      add_block(m, n, o, o, g, r_a, r_a, h);
+      own_block(c.a, g, r_a);
       const Vec3 t = r_a.cross(fc);
       for (int k = 0; k < 3; ++k) {
         r[o + k] -= h * fc[k];
@@ -392,9 +392,21 @@ void ImplicitStep::assemble_and_solve(const Model& model, const State& state,
       }
     }
     if (in_a && in_b) {
-      add_block(m, n, 6 * local_[c.b], 6 * local_[c.a], g, r_b, r_a, -h);
-      add_block(m, n, 6 * local_[c.a], 6 * local_[c.b], g, r_a, r_b, -h);
+      add_block<N>(m, n, 6 * local_[c.b], 6 * local_[c.a], g, r_b, r_a, -h);
+      add_block<N>(m, n, 6 * local_[c.a], 6 * local_[c.b], g, r_a, r_b, -h);
     }
+  }
+  for (int b : current_) {
+    const IsotropicSum& sum = iso_[local_[b]];
+    if (sum.g == 0.0) continue;
+    const int o = 6 * local_[b];
+    constexpr int kSize = N > 0 ? N : Eigen::Dynamic;
+    Eigen::Map<Eigen::Matrix<double, kSize, kSize, Eigen::RowMajor>> a(m, n, n);
+    const Mat3 s = h * skew(sum.g_arm);
+    a.template block<3, 3>(o, o).diagonal().array() += h * sum.g;
+    a.template block<3, 3>(o, o + 3) -= s;
+    a.template block<3, 3>(o + 3, o) += s;
+    a.template block<3, 3>(o + 3, o + 3) -= h * sum.g_arm2;
   }
   // Axis constraints: w1 . u = rate. The multiplier turns the body about the axis line through
   // `axis_point`, as a hinge (momentum M d, d = (u x (c - p), u) the twist of a unit turn about
@@ -402,22 +414,23 @@ void ImplicitStep::assemble_and_solve(const Model& model, const State& state,
   // not asked for the pivot's force (grasp_rules.hpp). Unsymmetric, so the elimination pivots.
   int row = 6 * static_cast<int>(current_.size());
   for (int b : current_) {
-    if (!axis_active[b]) continue;
+    if (!in.axis_active[b]) continue;
     const int o = 6 * local_[b];
     const BodyParams& bp = model.bodies[b];
     const Mat3& R = state.bodies[b].rotation;
-    const Vec3& u = axis[b];
-    const Vec3 dv = u.cross(state.bodies[b].position - axis_point[b]);              // m/s per rad/s
+    const Vec3& u = in.axis[b];
+    const Vec3 dv = u.cross(state.bodies[b].position - in.axis_point[b]);              // m/s per rad/s
     const Vec3 dl = R * bp.inertia.cwiseProduct(R.transpose() * u);                  // kg m^2
     for (int i = 0; i < 3; ++i) {
       m[row * n + o + 3 + i] = u[i];
       m[(o + i) * n + row] = bp.mass * dv[i];
       m[(o + 3 + i) * n + row] = dl[i];
     }
-    r[row] = axis_rate[b];
+    r[row] = in.axis_rate[b];
     ++row;
   }
-  lu_solve(m, r, n);
+  if constexpr (N == 6) dense::solve_one_body(m, r);
+  else dense::lu_solve(m, r, n);
   for (int b : current_) {
     const int o = 6 * local_[b];
     v1_[b] = Vec3(r[o], r[o + 1], r[o + 2]);

@@ -78,27 +78,34 @@ class ImplicitStep {
   static constexpr int kSettledSteps = 3;
 
  private:
+  // What every island of one solve() reads: the scene, the couplings, each body's external
+  // wrench and grasp rule.
+  struct Inputs {
+    const Model& model;
+    const State& state;
+    const std::vector<Coupling>& couplings;
+    const std::vector<Vec3>& force;                // N, world, per body
+    const std::vector<Vec3>& torque;               // N m, world, per body
+    const std::vector<std::uint8_t>& axis_active;  // per body
+    const std::vector<Vec3>& axis;                 // 1, world, per body
+    const std::vector<Vec3>& axis_point;           // m, world, per body
+    const std::vector<double>& axis_rate;          // rad/s, per body
+  };
+
   int find(int body);
-  void solve_island(const Model& model, const State& state, const std::vector<Coupling>& couplings,
-                    const std::vector<Vec3>& force, const std::vector<Vec3>& torque,
-                    const std::vector<std::uint8_t>& axis_active, const std::vector<Vec3>& axis,
-                    const std::vector<Vec3>& axis_point, const std::vector<double>& axis_rate, double h);
+  void solve_island(const Inputs& in, double h);
   std::uint64_t island_signature(const std::vector<Coupling>& couplings) const;
-  void assemble_and_solve(const Model& model, const State& state, const std::vector<Coupling>& couplings,
-                          const std::vector<Vec3>& v0, const std::vector<Vec3>& w0,
-                          const std::vector<Vec3>& force, const std::vector<Vec3>& torque,
-                          const std::vector<std::uint8_t>& axis_active, const std::vector<Vec3>& axis,
-                          const std::vector<Vec3>& axis_point, const std::vector<double>& axis_rate, double h);
+  void assemble_and_solve(const Inputs& in, double h);
+  // assemble_and_solve for an island of N unknowns (6: one body, no axis rule), N = 0 for any
+  // size (then `n` is the size).
+  template <int N>
+  void assemble_and_solve_n(const Inputs& in, int n, double h);
   Vec3 relative_velocity(const State& state, const Coupling& c, const std::vector<Vec3>& v,
                          const std::vector<Vec3>& w) const;
 
   std::vector<int> parent_;                 // union-find over bodies joined by body points
   std::vector<int> island_of_;              // body -> island index, or -1 (asleep)
   std::vector<int> local_;                  // body -> index inside its island
-  std::vector<int> island_bodies_;          // bodies grouped by island
-  std::vector<int> island_start_;           // island i: island_bodies_[start[i], start[i+1])
-  std::vector<int> island_couplings_;       // couplings grouped by island
-  std::vector<int> coupling_start_;         // likewise for couplings
   std::vector<double> matrix_;              // (7 n)^2, row-major: the island's system (6 per body, and
                                             //    a row per axis constraint), then its factor
   std::vector<double> rhs_;                 // 7 n: right side, then the solution
@@ -114,6 +121,13 @@ class ImplicitStep {
                                             //    displacement rates
   std::vector<std::uint8_t> second_order_;  // per body: its island took the BDF2 step
   std::vector<std::uint64_t> signature_;    // per body: its island's couplings and modes
+  // Per body of the island: its isotropic points' g, g r and g S(r)^2 summed (N s/m, N s, N s m).
+  struct IsotropicSum {
+    double g = 0.0;
+    Vec3 g_arm = Vec3::Zero();
+    Mat3 g_arm2 = Mat3::Zero();
+  };
+  std::vector<IsotropicSum> iso_;
   std::vector<int> current_;                // the island being solved: its bodies, couplings
   std::vector<int> current_couplings_;
 };
