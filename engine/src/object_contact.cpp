@@ -167,14 +167,35 @@ int floor_contact(const Model& model, int body, BodyState& bs, Wrench& out) {
   return touching;
 }
 
-int floor_couplings(const Model& model, int body, BodyState& bs, double h, std::vector<Coupling>& out) {
+int floor_couplings(const Model& model, int body, BodyState& bs, double h, double radius, std::vector<Coupling>& out) {
   const BodyParams& bp = model.bodies[body];
   const ContactPair pair = floor_pair(model, body);
   const double floor_z = model.floor.height;
   const double reach = h * h * model.gravity.norm();   // m: how far gravity alone carries a point in a step
   int appended = 0;
   const int count = static_cast<int>(bs.floor_contacts.size());
+  // A vertex (box, hull, mesh) higher above the floor than any point of the body can close in
+  // the step, h (max(0, -v_z) + |w| radius) + reach, is inactive without the full test, whose own
+  // bound, from the vertex's velocity, is never larger. Its height comes from one row of R; the
+  // margin, 1e-12 m per metre of the numbers involved, covers the few ulps by which that differs
+  // from the full product.
+  const std::vector<Vec3>* vertices = nullptr;
+  if (bp.shape.kind == ShapeKind::kMesh && bp.shape.mesh) vertices = &bp.shape.mesh->vertices;
+  if (bp.shape.kind == ShapeKind::kConvex) {
+    vertices = bp.shape.hull ? &bp.shape.hull->vertices : (bp.shape.mesh ? &bp.shape.mesh->vertices : nullptr);
+  }
+  const bool screened = vertices || bp.shape.kind == ShapeKind::kBox;
+  const Vec3 row_z = bs.rotation.row(2).transpose();
+  const double screen = h * (std::max(0.0, -bs.velocity.z()) + bs.angular_velocity.norm() * radius) + reach +
+                        1e-12 * (1.0 + std::abs(bs.position.z()) + std::abs(floor_z) + radius);   // m
   for (int k = 0; k < count; ++k) {
+    if (screened) {
+      const Vec3 local = vertices ? (*vertices)[k] : box_vertex(bp.shape.half_extents, k);
+      if (bs.position.z() + row_z.dot(local) - floor_z > screen) {
+        bs.floor_contacts[k].active = false;
+        continue;
+      }
+    }
     FloorPoint p;
     if (!track_floor_point(bp, bs, pair, floor_z, k, h, reach, p)) continue;
     VertexContact& vc = bs.floor_contacts[k];

@@ -71,7 +71,7 @@ void Simulation::implicit_contacts(const Input& input) {
         }
         continue;
       }
-      floor_clear_[b] = floor_couplings(model_, static_cast<int>(b), bs, h, couplings_) == 0 ? 1 : 0;
+      floor_clear_[b] = floor_couplings(model_, static_cast<int>(b), bs, h, floor_reach_[b], couplings_) == 0 ? 1 : 0;
     }
   }
   body_contacts_.couplings(model_, state_, couplings_, contact_points_);
