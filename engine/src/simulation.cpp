@@ -38,6 +38,8 @@ Simulation::Simulation(Model model)
       contact_points_(model_.bodies.size(), 0),
       implicit_(model_) {
   collision_.update(model_, state_);
+  to_haptic_ = (divisors_.haptic - state_.tick % divisors_.haptic) % divisors_.haptic;
+  to_physics_ = (divisors_.physics - state_.tick % divisors_.physics) % divisors_.physics;
   scratch_.reserve(model_.bodies.size());
   // How far below its centre of mass a body can reach the floor, with 1e-9 to spare.
   std::size_t floor_points = 0;
@@ -71,13 +73,15 @@ Simulation::Simulation(Model model)
 void Simulation::step(const Input& input, TickRecord& record) {
   const std::int64_t n = state_.tick;
   record.tick = n;
-  record.haptic_ran = n % divisors_.haptic == 0;
-  record.physics_ran = n % divisors_.physics == 0;
+  record.haptic_ran = to_haptic_ == 0;     // tick % (servo / haptic) == 0
+  record.physics_ran = to_physics_ == 0;   // tick % (servo / physics) == 0
   record.diverged_body = -1;
   if (record.haptic_ran) haptic_stage(input, record);   // 2: the friction cone, finger by finger
   servo_stage(input, record);                           // 3: finger forces, reactions into the window
   if (record.physics_ran) physics_stage(input, record); // 4: move the bodies
   ++state_.tick;                                        // 5
+  to_haptic_ = (record.haptic_ran ? divisors_.haptic : to_haptic_) - 1;
+  to_physics_ = (record.physics_ran ? divisors_.physics : to_physics_) - 1;
 }
 
 void Simulation::haptic_stage(const Input& input, TickRecord& record) {

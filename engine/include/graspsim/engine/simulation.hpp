@@ -70,6 +70,10 @@ class Simulation {
   Model model_;
   Divisors divisors_;
   State state_;
+  // Servo ticks until the haptic and the physics loops next run (0: at this tick): the clock's
+  // remainders by the divisors, kept by counting. (Two 64-bit divisions a tick cost an idle servo
+  // tick as much as the rest of its work.) Only step() moves the clock, so they cannot drift.
+  std::int64_t to_haptic_ = 0, to_physics_ = 0;
   std::shared_ptr<detail::FclWorld> fcl_;   // the bodies' FCL objects, one world for both below
   CollisionWorld collision_;
   bool collision_stale_ = false;   // bodies moved since collision_ was last updated
