@@ -216,6 +216,12 @@ void File::flush() {
   check(H5Fflush(handles_->file.get(), H5F_SCOPE_GLOBAL), path_ + ": cannot flush it");
 }
 
+struct LibraryLock::Held {
+  h5::Lock lock;
+};
+LibraryLock::LibraryLock() : held_(std::make_unique<Held>()) {}
+LibraryLock::~LibraryLock() = default;
+
 std::int64_t open_object_count() {
   Guard guard;
   const ssize_t n = H5Fget_obj_count(H5F_OBJ_ALL, H5F_OBJ_FILE | H5F_OBJ_GROUP | H5F_OBJ_DATASET | H5F_OBJ_ATTR);

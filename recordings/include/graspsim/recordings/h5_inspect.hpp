@@ -154,6 +154,21 @@ class File {
   std::unique_ptr<Handles> handles_;
 };
 
+// Holds the module's process-wide HDF5 lock (every HDF5 call of recordings/ takes it; Debian's
+// libhdf5 is not thread-safe) for its lifetime: while one is held, no other thread's trace
+// writer or reader reaches the file, which is how a test makes a background writer slow.
+class LibraryLock {
+ public:
+  LibraryLock();
+  ~LibraryLock();
+  LibraryLock(const LibraryLock&) = delete;
+  LibraryLock& operator=(const LibraryLock&) = delete;
+
+ private:
+  struct Held;
+  std::unique_ptr<Held> held_;
+};
+
 // Files, groups, datasets and attributes open in this process (H5Fget_obj_count): a reader that
 // closed everything it opened leaves 0.
 std::int64_t open_object_count();
