@@ -122,7 +122,8 @@ Found visit(const std::string& file) {
       const bool compound = d.type.type_class == inspect::TypeClass::kCompound;
       if (d.dims.size() != 1 || !compound) f.datasets.insert({generic(path), "not a table", "?", "?"});
       for (const inspect::Member& m : d.members) {
-        const std::string shape = m.type.type_class == inspect::TypeClass::kArray ? "(n," + std::to_string(m.width) + ")" : "(n)";
+        const bool array = m.type.type_class == inspect::TypeClass::kArray;
+        const std::string shape = array ? "(n," + std::to_string(m.width) + ")" : "(n)";
         std::string units = "(none)";
         const std::string key = m.name + "/units";
         if (h5.has_attribute(path, key)) units = h5.read_string_attribute(path, key);

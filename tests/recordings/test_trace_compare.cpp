@@ -1,7 +1,7 @@
 // Tests of compare_traces on small synthetic traces written by TraceWriter and edited in place
-// through the schema-free HDF5 view (h5_inspect.hpp): alignment by tick, the first divergence located by tick, time, dataset,
-// object or finger and component, tolerances (global, per dataset, glob), bitwise mode, and
-// every kind of unusable input.
+// through the schema-free HDF5 view (h5_inspect.hpp): alignment by tick, the first divergence
+// located by tick, time, dataset, object or finger and component, tolerances (global, per
+// dataset, glob), bitwise mode, and every kind of unusable input.
 #include <catch2/catch.hpp>
 
 #include <cmath>
