@@ -1,11 +1,11 @@
 // `graspsim compare` as a user meets it, on real traces of the two-finger lift: identical runs
-// compare equal bit for bit, a 1e-9 m change written into one trace with the HDF5 C API is
+// compare equal bit for bit, a 1e-9 m change written into one trace in place (trace_edit.hpp) is
 // found at its tick, time, object and component (exit 1), tolerances decide, --json is valid
 // JSON, and every kind of unusable input exits 2 with a message naming the file or dataset.
 #include <catch2/catch.hpp>
-#include <hdf5.h>
 
 #include <cctype>
+#include <cstdint>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -36,7 +36,8 @@ void run_lift(const std::string& out, const std::string& extra = "") {
 }
 
 // Adds `delta` to element (row, column) of column `path`, returning the new value.
-double nudge(const std::string& file, const std::string& path, hsize_t row, hsize_t column, double delta) {
+double nudge(const std::string& file, const std::string& path, std::uint64_t row, std::uint64_t column,
+             double delta) {
   return graspsim::test::add_to_element(file, path, row, column, delta);
 }
 

@@ -5,7 +5,6 @@
 // std::bad_alloc (every command runs under `timeout`, so a hang shows as status 124 and a
 // signal as 128 + its number). README.md, "What can go wrong", lists the promises.
 #include <catch2/catch.hpp>
-#include <hdf5.h>
 #include <sys/stat.h>
 
 #include <cmath>
@@ -18,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include "graspsim/recordings/h5_inspect.hpp"
 #include "graspsim/recordings/trace_reader.hpp"
 #include "tests/support/shell.hpp"
 #include "tests/support/trace_edit.hpp"
@@ -137,15 +137,8 @@ TEST_CASE("catalogue: a trace with a 2^36-row extent, a FIFO or a device as a tr
           "[e2e][catalogue][trace]") {
   use_dir("extent");
   const std::string big = copy_of_lift("extent.h5");
-  {
-    const hid_t f = H5Fopen(big.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
-    REQUIRE(f >= 0);
-    const hid_t d = H5Dopen2(f, "/servo", H5P_DEFAULT);
-    const hsize_t rows[1] = {hsize_t{1} << 36};
-    REQUIRE(H5Dset_extent(d, rows) >= 0);
-    H5Dclose(d);
-    H5Fclose(f);
-  }
+  using graspsim::recordings::inspect::File;
+  File::open(big, File::Mode::kReadWrite).set_extent("/servo", {std::uint64_t{1} << 36});
   std::error_code ec;
   fs::remove(path("fifo.h5"), ec);
   REQUIRE(::mkfifo(path("fifo.h5").c_str(), 0600) == 0);
@@ -232,25 +225,10 @@ TEST_CASE("catalogue: 300 seeded one-byte mutants of a trace's metadata: compare
   // The raw data of the three tables, from their chunks' addresses.
   std::vector<std::pair<std::uint64_t, std::uint64_t>> data;   // (offset, size), bytes
   {
-    const hid_t f = H5Fopen(lift_trace().c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
-    REQUIRE(f >= 0);
-    for (const char* table : {"/servo", "/haptic", "/physics"}) {
-      const hid_t d = H5Dopen2(f, table, H5P_DEFAULT);
-      const hid_t space = H5Dget_space(d);
-      hsize_t chunks = 0;
-      REQUIRE(H5Dget_num_chunks(d, space, &chunks) >= 0);
-      for (hsize_t k = 0; k < chunks; ++k) {
-        hsize_t offset[1] = {0};
-        unsigned mask = 0;
-        haddr_t address = 0;
-        hsize_t size = 0;
-        REQUIRE(H5Dget_chunk_info(d, space, k, offset, &mask, &address, &size) >= 0);
-        data.emplace_back(address, size);
-      }
-      H5Sclose(space);
-      H5Dclose(d);
-    }
-    H5Fclose(f);
+    namespace inspect = graspsim::recordings::inspect;
+    const inspect::File f = inspect::File::open(lift_trace());
+    for (const char* table : {"/servo", "/haptic", "/physics"})
+      for (const inspect::Chunk& chunk : f.chunks(table)) data.emplace_back(chunk.address, chunk.bytes);
   }
   std::vector<std::uint64_t> metadata;   // byte positions
   for (std::uint64_t i = 0; i < original.size(); ++i) {

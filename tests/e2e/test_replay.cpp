@@ -4,7 +4,6 @@
 // with another mu keeps the hand motion and parts where friction first matters; bad input exits 2
 // with a message naming the file and what is wrong, writing nothing.
 #include <catch2/catch.hpp>
-#include <hdf5.h>
 
 #include <cstdint>
 #include <cstdio>
@@ -16,6 +15,7 @@
 
 #include "app/replay.hpp"
 #include "app/run.hpp"
+#include "graspsim/recordings/h5_inspect.hpp"
 #include "graspsim/recordings/trace_compare.hpp"
 #include "graspsim/recordings/trace_reader.hpp"
 #include "graspsim/scripting/scenario.hpp"
@@ -98,13 +98,10 @@ void check_reproduced(const std::string& scenario, const std::string& name) {
 // Copies a trace and sets one int64 root attribute in the copy.
 std::string with_int_attribute(const std::string& trace, const std::string& out, const char* name, std::int64_t value) {
   std::filesystem::copy_file(trace, out, std::filesystem::copy_options::overwrite_existing);
-  const hid_t f = H5Fopen(out.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
-  REQUIRE(f >= 0);
-  const hid_t a = H5Aopen(f, name, H5P_DEFAULT);
-  REQUIRE(a >= 0);
-  REQUIRE(H5Awrite(a, H5T_NATIVE_INT64, &value) >= 0);
-  H5Aclose(a);
-  H5Fclose(f);
+  using recordings::inspect::File;
+  File f = File::open(out, File::Mode::kReadWrite);
+  REQUIRE(f.has_attribute("/", name));   // written in place, its stored type kept
+  f.write_int_attribute("/", name, value);
   return out;
 }
 

@@ -1,7 +1,6 @@
 // A run's memory and disk, estimated before it starts (app/run_budget.hpp): the estimate
 // against what a run actually writes, and the refusal when a machine cannot hold it.
 #include <catch2/catch.hpp>
-#include <hdf5.h>
 
 #include <string>
 #include <vector>
@@ -10,6 +9,7 @@
 #include "app/run_budget.hpp"
 #include "graspsim/hw/replay_device.hpp"
 #include "graspsim/hw/scripted_finger.hpp"
+#include "graspsim/recordings/h5_inspect.hpp"
 #include "graspsim/recordings/trace_reader.hpp"
 #include "graspsim/scripting/scenario.hpp"
 
@@ -32,21 +32,10 @@ struct Stored {
   double storage = 0.0, chunk = 0.0, row = 0.0;   // bytes
 };
 Stored stored(const std::string& file, const std::string& table) {
-  const hid_t f = H5Fopen(file.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
-  REQUIRE(f >= 0);
-  const hid_t d = H5Dopen2(f, table.c_str(), H5P_DEFAULT);
-  REQUIRE(d >= 0);
-  const hid_t type = H5Dget_type(d);
-  const hid_t plist = H5Dget_create_plist(d);
-  hsize_t chunk[1] = {0};
-  REQUIRE(H5Pget_chunk(plist, 1, chunk) == 1);
-  Stored out{static_cast<double>(H5Dget_storage_size(d)), static_cast<double>(chunk[0] * H5Tget_size(type)),
-             static_cast<double>(H5Tget_size(type))};
-  H5Pclose(plist);
-  H5Tclose(type);
-  H5Dclose(d);
-  H5Fclose(f);
-  return out;
+  const recordings::inspect::DatasetInfo d = recordings::inspect::File::open(file).dataset(table);
+  REQUIRE(d.chunk.size() == 1);
+  return Stored{static_cast<double>(d.storage_bytes), static_cast<double>(d.chunk[0] * d.type.bytes),
+                static_cast<double>(d.type.bytes)};
 }
 
 std::vector<hw::Vec3> rows(const recordings::Dataset& d) {

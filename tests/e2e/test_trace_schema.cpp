@@ -4,7 +4,6 @@
 // /haptic and /physics columns are exactly the recorder's field tables (trace_schema.hpp).
 // Parses the README; fails when they disagree, naming the difference.
 #include <catch2/catch.hpp>
-#include <hdf5.h>
 
 #include <fstream>
 #include <set>
@@ -14,6 +13,7 @@
 #include <vector>
 
 #include "app/run.hpp"
+#include "graspsim/recordings/h5_inspect.hpp"
 #include "graspsim/recordings/trace_schema.hpp"
 #include "graspsim/scripting/scenario.hpp"
 
@@ -88,109 +88,61 @@ std::string generic(const std::string& path) {
   return out.empty() ? "/" : out;
 }
 
-std::string type_name(hid_t type) {
-  const H5T_class_t c = H5Tget_class(type);
-  const std::size_t size = H5Tget_size(type);
-  if (c == H5T_STRING) return "string";
-  if (c == H5T_FLOAT) return "float" + std::to_string(8 * size);
-  if (c == H5T_INTEGER) return (H5Tget_sign(type) == H5T_SGN_NONE ? "uint" : "int") + std::to_string(8 * size);
-  return "?";
+namespace inspect = recordings::inspect;
+
+std::string type_name(const inspect::Type& type) {
+  const std::string bits = std::to_string(8 * type.bytes);
+  switch (type.type_class) {
+    case inspect::TypeClass::kString: return "string";
+    case inspect::TypeClass::kFloat: return "float" + bits;
+    case inspect::TypeClass::kInteger: return (type.is_signed ? "int" : "uint") + bits;
+    default: return "?";
+  }
 }
 
 struct Found {
-  hid_t file;
   std::set<DatasetRow> datasets;
   std::set<AttributeRow> attributes;
   std::vector<std::string> units_missing;   // datasets without a units attribute
-  std::string current;                      // object whose attributes are being listed
-  bool current_is_dataset = false;
 };
 
-std::string string_attribute(hid_t attribute) {
-  hid_t type = H5Aget_type(attribute);
-  hid_t memory = H5Tcopy(H5T_C_S1);
-  H5Tset_size(memory, H5T_VARIABLE);
-  H5Tset_cset(memory, H5Tget_cset(type));
-  char* text = nullptr;
-  std::string value;
-  if (H5Tis_variable_str(type) > 0 && H5Aread(attribute, memory, &text) >= 0 && text) {
-    value = text;
-    H5free_memory(text);
-  }
-  H5Tclose(memory);
-  H5Tclose(type);
-  return value;
-}
-
-// An attribute of a table dataset named "<column>/<name>" belongs to that column (schema 3);
-// "units" of every column is listed once, as "every column".
-herr_t on_attribute(hid_t object, const char* name, const H5A_info_t*, void* data) {
-  Found& f = *static_cast<Found*>(data);
-  hid_t attribute = H5Aopen(object, name, H5P_DEFAULT);
-  hid_t type = H5Aget_type(attribute);
-  const std::string type_str = type_name(type);
-  H5Tclose(type);
-  const std::string n = name;
-  const auto slash = n.rfind('/');
-  if (f.current_is_dataset && slash != std::string::npos) {
-    const std::string column = f.current + "/" + n.substr(0, slash), key = n.substr(slash + 1);
-    if (key == "units") f.attributes.insert({"every column", "units", type_str});
-    else f.attributes.insert({generic(column), key, type_str});
-  } else {
-    f.attributes.insert({generic(f.current), n, type_str});
-  }
-  H5Aclose(attribute);
-  return 0;
-}
-
-herr_t on_object(hid_t root, const char* name, const H5O_info_t* info, void* data) {
-  Found& f = *static_cast<Found*>(data);
-  std::string path = "/";
-  if (std::string(name) != ".") path += name;
-  hid_t object = H5Oopen(root, name, H5P_DEFAULT);
-  f.current = path;
-  f.current_is_dataset = info->type == H5O_TYPE_DATASET;
-  if (f.current_is_dataset) {
-    // A table: one compound dataset of shape (n); each member is a column, an array member
-    // of width w a column of shape (n,w); its units are attribute "<member>/units".
-    hid_t space = H5Dget_space(object);
-    const int rank = H5Sget_simple_extent_ndims(space);
-    H5Sclose(space);
-    hid_t row = H5Dget_type(object);
-    if (rank != 1 || H5Tget_class(row) != H5T_COMPOUND) f.datasets.insert({generic(path), "not a table", "?", "?"});
-    const int members = H5Tget_class(row) == H5T_COMPOUND ? H5Tget_nmembers(row) : 0;
-    for (int k = 0; k < members; ++k) {
-      char* member_name = H5Tget_member_name(row, static_cast<unsigned>(k));
-      const std::string member = member_name;
-      H5free_memory(member_name);
-      hid_t type = H5Tget_member_type(row, static_cast<unsigned>(k));
-      std::string shape = "(n)";
-      hid_t base = H5Tcopy(type);
-      if (H5Tget_class(type) == H5T_ARRAY) {
-        hsize_t width = 0;
-        H5Tget_array_dims2(type, &width);
-        shape = "(n," + std::to_string(width) + ")";
-        H5Tclose(base);
-        base = H5Tget_super(type);
+// Every object of the file, read through the schema-free view (not the trace reader). A table is
+// one compound dataset of shape (n); each member is a column, an array member of width w a column
+// of shape (n,w); its units are attribute "<member>/units". An attribute of a table dataset named
+// "<column>/<name>" belongs to that column (schema 3); "units" of every column is listed once, as
+// "every column".
+Found visit(const std::string& file) {
+  Found f;
+  const inspect::File h5 = inspect::File::open(file);
+  for (const inspect::Object& object : h5.objects()) {
+    const std::string& path = object.path;
+    const bool is_dataset = object.kind == inspect::ObjectKind::kDataset;
+    if (is_dataset) {
+      const inspect::DatasetInfo d = h5.dataset(path);
+      const bool compound = d.type.type_class == inspect::TypeClass::kCompound;
+      if (d.dims.size() != 1 || !compound) f.datasets.insert({generic(path), "not a table", "?", "?"});
+      for (const inspect::Member& m : d.members) {
+        const bool array = m.type.type_class == inspect::TypeClass::kArray;
+        const std::string shape = array ? "(n," + std::to_string(m.width) + ")" : "(n)";
+        std::string units = "(none)";
+        const std::string key = m.name + "/units";
+        if (h5.has_attribute(path, key)) units = h5.read_string_attribute(path, key);
+        else f.units_missing.push_back(path + "/" + m.name);
+        f.datasets.insert({generic(path + "/" + m.name), shape, type_name(m.element), units});
       }
-      std::string units = "(none)";
-      const std::string key = member + "/units";
-      if (H5Aexists(object, key.c_str()) > 0) {
-        hid_t a = H5Aopen(object, key.c_str(), H5P_DEFAULT);
-        units = string_attribute(a);
-        H5Aclose(a);
-      } else {
-        f.units_missing.push_back(path + "/" + member);
-      }
-      f.datasets.insert({generic(path + "/" + member), shape, type_name(base), units});
-      H5Tclose(base);
-      H5Tclose(type);
     }
-    H5Tclose(row);
+    for (const inspect::Attribute& a : h5.attributes(path)) {
+      const auto slash = a.name.rfind('/');
+      if (is_dataset && slash != std::string::npos) {
+        const std::string column = path + "/" + a.name.substr(0, slash), key = a.name.substr(slash + 1);
+        if (key == "units") f.attributes.insert({"every column", "units", type_name(a.type)});
+        else f.attributes.insert({generic(column), key, type_name(a.type)});
+      } else {
+        f.attributes.insert({generic(path), a.name, type_name(a.type)});
+      }
+    }
   }
-  H5Aiterate2(object, H5_INDEX_NAME, H5_ITER_INC, nullptr, on_attribute, &f);
-  H5Oclose(object);
-  return 0;
+  return f;
 }
 
 template <typename T>
@@ -245,11 +197,7 @@ TEST_CASE("recordings/README.md documents exactly the datasets and attributes of
   }
 
   // The file's datasets and attributes, every object visited.
-  Found found;
-  found.file = H5Fopen(options.out.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
-  REQUIRE(found.file >= 0);
-  H5Ovisit2(found.file, H5_INDEX_NAME, H5_ITER_INC, on_object, &found, H5O_INFO_BASIC);
-  H5Fclose(found.file);
+  const Found found = visit(options.out);
 
   INFO("in the trace, not in the README (path | shape | dtype | units):\n" << list(minus(found.datasets, documented)));
   INFO("in the README, not in the trace:\n" << list(minus(documented, found.datasets)));

@@ -6,14 +6,13 @@
 // same; no HDF5 file, group, dataset or attribute is left open afterwards. Anything else (a
 // crash, in our code or inside libhdf5, a sanitizer finding, another exception, memory past
 // -rss_limit_mb) is a finding.
-#include <hdf5.h>
-
 #include <cstddef>
 #include <cstdint>
 #include <cstdlib>
 #include <string>
 #include <vector>
 
+#include "graspsim/recordings/h5_inspect.hpp"
 #include "graspsim/recordings/trace_compare.hpp"
 #include "graspsim/recordings/trace_reader.hpp"
 #include "tests/fuzz/fuzz_file.hpp"
@@ -67,6 +66,6 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   });
   // Every file, group, dataset and attribute the reader and compare opened is closed, refused or
   // not (a datatype may be one the reader keeps for the process).
-  require(H5Fget_obj_count(H5F_OBJ_ALL, H5F_OBJ_FILE | H5F_OBJ_GROUP | H5F_OBJ_DATASET | H5F_OBJ_ATTR) == 0);
+  require(recordings::inspect::open_object_count() == 0);
   return 0;
 }

@@ -2,11 +2,11 @@
 // bit; the same scenario gives the same trace in one process, in two processes and from a Debug and
 // a Release build. README.md, "Golden traces" and "Determinism".
 #include <catch2/catch.hpp>
-#include <hdf5.h>
 #include <sys/wait.h>
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <filesystem>
 #include <string>
@@ -14,6 +14,7 @@
 
 #include "app/replay.hpp"
 #include "app/golden.hpp"
+#include "graspsim/recordings/h5_inspect.hpp"
 #include "graspsim/recordings/trace_reader.hpp"
 #include "graspsim/scripting/scenario.hpp"
 #include "tests/support/shell.hpp"
@@ -36,26 +37,15 @@ using graspsim::test::Outcome;
 using graspsim::test::shell;
 
 // Adds `delta` to element (row, component) of a float64 column, in place.
-void perturb(const std::string& file, const std::string& path, hsize_t row, hsize_t component, double delta) {
+void perturb(const std::string& file, const std::string& path, std::uint64_t row, std::uint64_t component,
+             double delta) {
   graspsim::test::add_to_element(file, path, row, component, delta);
 }
 
 // Replaces the root string attribute `name` (a golden "written elsewhere").
 void set_root_string(const std::string& file, const std::string& name, const std::string& value) {
-  const hid_t f = H5Fopen(file.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
-  REQUIRE(f >= 0);
-  const hid_t type = H5Tcopy(H5T_C_S1);
-  H5Tset_size(type, H5T_VARIABLE);
-  const hid_t space = H5Screate(H5S_SCALAR);
-  if (H5Aexists(f, name.c_str()) > 0) H5Adelete(f, name.c_str());
-  const hid_t a = H5Acreate2(f, name.c_str(), type, space, H5P_DEFAULT, H5P_DEFAULT);
-  REQUIRE(a >= 0);
-  const char* text = value.c_str();
-  REQUIRE(H5Awrite(a, type, &text) >= 0);
-  H5Aclose(a);
-  H5Sclose(space);
-  H5Tclose(type);
-  H5Fclose(f);
+  using recordings::inspect::File;
+  File::open(file, File::Mode::kReadWrite).write_string_attribute("/", name, value);
 }
 
 }  // namespace

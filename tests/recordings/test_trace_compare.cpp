@@ -1,9 +1,8 @@
 // Tests of compare_traces on small synthetic traces written by TraceWriter and edited in place
-// with the HDF5 C API: alignment by tick, the first divergence located by tick, time, dataset,
-// object or finger and component, tolerances (global, per dataset, glob), bitwise mode, and
-// every kind of unusable input.
+// through the schema-free HDF5 view (h5_inspect.hpp): alignment by tick, the first divergence
+// located by tick, time, dataset, object or finger and component, tolerances (global, per
+// dataset, glob), bitwise mode, and every kind of unusable input.
 #include <catch2/catch.hpp>
-#include <hdf5.h>
 
 #include <cmath>
 #include <cstdint>
@@ -17,6 +16,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include "graspsim/recordings/h5_inspect.hpp"
 #include "graspsim/recordings/trace_compare.hpp"
 #include "graspsim/recordings/trace_writer.hpp"
 #include "tests/support/trace_edit.hpp"
@@ -426,36 +426,27 @@ void make_cut_swmr_trace(const std::string& path) {
   const pid_t child = fork();
   REQUIRE(child >= 0);
   if (child == 0) {
-    const hid_t fapl = H5Pcreate(H5P_FILE_ACCESS);
-    H5Pset_libver_bounds(fapl, H5F_LIBVER_LATEST, H5F_LIBVER_LATEST);
-    const hid_t f = H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, fapl);
-    if (f < 0) _exit(3);
-    const hid_t scalar = H5Screate(H5S_SCALAR);
-    const auto int_attr = [&](const char* name, long long v) {
-      const hid_t a = H5Acreate2(f, name, H5T_STD_I64LE, scalar, H5P_DEFAULT, H5P_DEFAULT);
-      H5Awrite(a, H5T_NATIVE_LLONG, &v);
-      H5Aclose(a);
-    };
-    int_attr("schema_version", 1);
-    int_attr("rate_servo", 1200);
-    int_attr("rate_haptic", 600);
-    int_attr("rate_physics", 300);
-    for (const char* group : {"servo", "haptic", "physics"}) {
-      const hid_t g = H5Gcreate2(f, group, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
-      const hsize_t dims[1] = {4}, max[1] = {H5S_UNLIMITED}, chunk[1] = {4};
-      const hid_t space = H5Screate_simple(1, dims, max);
-      const hid_t dcpl = H5Pcreate(H5P_DATASET_CREATE);
-      H5Pset_chunk(dcpl, 1, chunk);
-      const long long ticks[4] = {0, 4, 8, 12};
-      const double times[4] = {0.0, 4.0 / 1200, 8.0 / 1200, 12.0 / 1200};
-      const hid_t t = H5Dcreate2(g, "tick", H5T_STD_I64LE, space, H5P_DEFAULT, dcpl, H5P_DEFAULT);
-      H5Dwrite(t, H5T_NATIVE_LLONG, H5S_ALL, H5S_ALL, H5P_DEFAULT, ticks);
-      const hid_t s = H5Dcreate2(g, "time", H5T_IEEE_F64LE, space, H5P_DEFAULT, dcpl, H5P_DEFAULT);
-      H5Dwrite(s, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, times);
+    // A failure is the child's exit status: 4 when SWMR writing cannot start, else 3. _exit runs
+    // no destructor, so the file is never closed.
+    int failure = 3;
+    try {
+      inspect::File f = inspect::File::create(path, inspect::File::Format::kLatest);
+      for (const auto& [name, v] : {std::pair{"schema_version", 1}, std::pair{"rate_servo", 1200},
+                                    std::pair{"rate_haptic", 600}, std::pair{"rate_physics", 300}})
+        f.write_int_attribute("/", name, v);
+      for (const std::string group : {"servo", "haptic", "physics"}) {
+        f.create_group(group);
+        f.create_dataset(group + "/tick", std::vector<std::int64_t>{0, 4, 8, 12}, 4);
+        f.create_dataset(group + "/time", std::vector<double>{0.0, 4.0 / 1200, 8.0 / 1200, 12.0 / 1200}, 4);
+      }
+      failure = 4;
+      f.start_swmr_write();
+      failure = 3;
+      f.flush();
+      _exit(0);   // no close: the file keeps its "open for writing" mark
+    } catch (...) {
+      _exit(failure);
     }
-    if (H5Fstart_swmr_write(f) < 0) _exit(4);
-    H5Fflush(f, H5F_SCOPE_GLOBAL);
-    _exit(0);   // no close: the file keeps its "open for writing" mark
   }
   int status = 0;
   REQUIRE(waitpid(child, &status, 0) == child);
@@ -469,14 +460,7 @@ TEST_CASE("a SWMR trace cut by a crash is opened in SWMR read mode, with a note"
   const std::string cut = tmp_path("swmr_cut.h5");
   make_cut_swmr_trace(cut);
   // A plain read-only open refuses it (the mark a killed SWMR writer leaves).
-  H5E_auto2_t func = nullptr;
-  void* data = nullptr;
-  H5Eget_auto2(H5E_DEFAULT, &func, &data);
-  H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
-  const hid_t plain = H5Fopen(cut.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
-  H5Eset_auto2(H5E_DEFAULT, func, data);
-  if (plain >= 0) H5Fclose(plain);
-  CHECK(plain < 0);
+  CHECK_THROWS_AS(inspect::File::open(cut), inspect::InspectError);
 
   const CompareResult r = compare_traces(cut, cut);
   CHECK(r.same());

@@ -9,9 +9,9 @@
 #include <string>
 #include <thread>
 
+#include "graspsim/recordings/h5_inspect.hpp"
 #include "graspsim/recordings/trace_reader.hpp"
 #include "graspsim/recordings/trace_writer.hpp"
-#include "recordings/src/h5.hpp"
 #include "tests/support/library.hpp"
 
 using namespace graspsim::recordings;
@@ -98,7 +98,7 @@ TEST_CASE("after wait(ticket) the flush's rows are on disk, however slow the wri
     stalls.thread = std::thread([&] {
       while (!stop.load()) {
         {
-          graspsim::recordings::h5::Lock hold;   // the writer thread cannot touch the file
+          graspsim::recordings::inspect::LibraryLock hold;   // the writer thread cannot touch the file
           std::this_thread::sleep_for(std::chrono::milliseconds(stall));
         }
         std::this_thread::sleep_for(std::chrono::milliseconds(1));

@@ -1,7 +1,6 @@
 // Tests of TraceRecorder: the engine's tick records land in /servo, /haptic and /physics with
 // the documented names, units, row counts and exact values, without allocating.
 #include <catch2/catch.hpp>
-#include <hdf5.h>
 
 #include <atomic>
 #include <bit>
@@ -16,6 +15,7 @@
 #include "graspsim/engine/model.hpp"
 #include "graspsim/engine/record.hpp"
 #include "graspsim/engine/state_hash.hpp"
+#include "graspsim/recordings/h5_inspect.hpp"
 #include "graspsim/recordings/trace_reader.hpp"
 #include "graspsim/recordings/trace_recorder.hpp"
 #include "tests/support/library.hpp"
@@ -185,16 +185,9 @@ TEST_CASE("the recorder sizes each table's chunk to chunk_ticks servo ticks", "[
     writer.close("complete");
   }
   const auto chunk_rows = [&](const std::string& path) {
-    const hid_t f = H5Fopen(file.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
     // Schema 3: the column's chunk is its table's ("/servo" for "/servo/fingers/thumb/hip").
-    const hid_t d = H5Dopen2(f, path.substr(0, path.find('/', 1)).c_str(), H5P_DEFAULT);
-    const hid_t plist = H5Dget_create_plist(d);
-    hsize_t dims[2] = {0, 0};
-    const int rank = H5Pget_chunk(plist, 2, dims);
-    H5Pclose(plist);
-    H5Dclose(d);
-    H5Fclose(f);
-    return rank >= 1 ? static_cast<std::int64_t>(dims[0]) : -1;
+    const inspect::DatasetInfo d = inspect::File::open(file).dataset(path.substr(0, path.find('/', 1)));
+    return d.chunk.empty() ? -1 : static_cast<std::int64_t>(d.chunk[0]);
   };
   CHECK(chunk_rows("/servo/tick") == 25);
   CHECK(chunk_rows("/servo/fingers/thumb/hip") == 25);
@@ -418,18 +411,12 @@ TEST_CASE("row_sizes counts the doubles and bytes of every row the recorder decl
         CHECK(writer.table("physics").row_width() == rows.physics.values);
         writer.close("complete");
       }
-      const hid_t f = H5Fopen(file.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
-      REQUIRE(f >= 0);
+      const inspect::File f = inspect::File::open(file);
       for (const auto& [table, size] : {std::pair{"/servo", rows.servo}, std::pair{"/haptic", rows.haptic},
                                         std::pair{"/physics", rows.physics}}) {
-        const hid_t d = H5Dopen2(f, table, H5P_DEFAULT);
-        const hid_t type = H5Dget_type(d);
         INFO(table);
-        CHECK(H5Tget_size(type) == size.bytes);
-        H5Tclose(type);
-        H5Dclose(d);
+        CHECK(f.dataset(table).type.bytes == size.bytes);
       }
-      H5Fclose(f);
     }
   }
 }

@@ -1,7 +1,6 @@
 // Crash safety of the writer: SWMR from the first row, attributes kept for close, a cut file
 // readable by a SWMR reader, and repair_trace (the `graspsim repair` step).
 #include <catch2/catch.hpp>
-#include <hdf5.h>
 
 #include <cstdint>
 #include <cstdio>
@@ -12,6 +11,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include "graspsim/recordings/h5_inspect.hpp"
 #include "graspsim/recordings/trace_reader.hpp"
 #include "graspsim/recordings/trace_repair.hpp"
 #include "graspsim/recordings/trace_writer.hpp"
@@ -28,15 +28,12 @@ std::string tmp_path(const std::string& name) {
 
 // Whether HDF5 opens the file read-only without SWMR (what h5dump does).
 bool opens_plainly(const std::string& file) {
-  H5E_auto2_t func = nullptr;
-  void* data = nullptr;
-  H5Eget_auto2(H5E_DEFAULT, &func, &data);
-  H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
-  const hid_t id = H5Fopen(file.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
-  H5Eset_auto2(H5E_DEFAULT, func, data);
-  if (id < 0) return false;
-  H5Fclose(id);
-  return true;
+  try {
+    (void)inspect::File::open(file);
+    return true;
+  } catch (const inspect::InspectError&) {
+    return false;
+  }
 }
 
 // A child process writes `rows` rows of table "t" (block 4), flushes after `flush_at` rows, and
@@ -153,6 +150,6 @@ TEST_CASE("repair_trace leaves complete traces alone and refuses files that are 
   CHECK_THROWS_WITH(repair_trace(text), Catch::Contains(text) && Catch::Contains("not an HDF5 file"));
 
   const std::string foreign = tmp_path("foreign.h5");
-  H5Fclose(H5Fcreate(foreign.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT));
+  (void)inspect::File::create(foreign);   // an empty HDF5 file
   CHECK_THROWS_WITH(repair_trace(foreign), Catch::Contains(foreign) && Catch::Contains("not a graspsim trace"));
 }

@@ -1,7 +1,6 @@
 // Tests of TraceWriter/TraceTable and the read helpers: round trips, shapes, dtypes, status,
 // errors, and that HDF5 never prints to stderr.
 #include <catch2/catch.hpp>
-#include <hdf5.h>
 
 #include <bit>
 #include <cmath>
@@ -16,6 +15,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include "graspsim/recordings/h5_inspect.hpp"
 #include "graspsim/recordings/trace_reader.hpp"
 #include "graspsim/recordings/trace_writer.hpp"
 #include "tests/support/library.hpp"
@@ -122,42 +122,19 @@ void check_mixed(const std::string& file, const std::string& group, std::int64_t
 }
 
 // Chunk dimensions and deflate level of the table dataset that holds column `path` (schema 3:
-// "/t/x" is member "x" of dataset "/t"), read with the HDF5 C API directly.
+// "/t/x" is member "x" of dataset "/t"), read through the schema-free HDF5 view, not the
+// trace reader.
 struct Layout {
-  std::vector<hsize_t> chunk;
-  std::vector<hsize_t> max_dims;
+  std::vector<std::uint64_t> chunk;
+  std::vector<std::uint64_t> max_dims;
   int deflate = 0;   // 0 = no deflate filter
 };
 Layout layout_of(const std::string& file, const std::string& path) {
-  Layout out;
-  const hid_t f = H5Fopen(file.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
-  REQUIRE(f >= 0);
-  const std::string table = path.substr(0, path.find('/', 1));
-  const hid_t d = H5Dopen2(f, table.c_str(), H5P_DEFAULT);
-  REQUIRE(d >= 0);
-  const hid_t space = H5Dget_space(d);
-  const int rank = H5Sget_simple_extent_ndims(space);
-  out.max_dims.resize(static_cast<std::size_t>(rank));
-  H5Sget_simple_extent_dims(space, nullptr, out.max_dims.data());
-  const hid_t dcpl = H5Dget_create_plist(d);
-  REQUIRE(H5Pget_layout(dcpl) == H5D_CHUNKED);
-  out.chunk.resize(static_cast<std::size_t>(rank));
-  H5Pget_chunk(dcpl, rank, out.chunk.data());
-  for (int i = 0; i < H5Pget_nfilters(dcpl); ++i) {
-    unsigned flags = 0;
-    std::size_t count = 1;
-    unsigned level = 0;
-    unsigned config = 0;
-    char name[64];
-    const H5Z_filter_t filter =
-        H5Pget_filter2(dcpl, static_cast<unsigned>(i), &flags, &count, &level, sizeof name, name,
-                       &config);
-    if (filter == H5Z_FILTER_DEFLATE) out.deflate = static_cast<int>(level);
-  }
-  H5Pclose(dcpl);
-  H5Sclose(space);
-  H5Dclose(d);
-  H5Fclose(f);
+  const inspect::DatasetInfo d = inspect::File::open(file).dataset(path.substr(0, path.find('/', 1)));
+  REQUIRE(d.chunked);
+  Layout out{d.chunk, d.max_dims, 0};
+  for (const inspect::Filter& f : d.filters)
+    if (f.id == inspect::kFilterDeflate) out.deflate = f.values.empty() ? 0 : static_cast<int>(f.values[0]);
   return out;
 }
 
@@ -221,8 +198,8 @@ TEST_CASE("datasets are chunked by block_rows and unlimited along rows", "[trace
     writer.close("complete");
   }
   const Layout one = layout_of(file, "/t/one");
-  CHECK(one.chunk == std::vector<hsize_t>{16});
-  CHECK(one.max_dims == std::vector<hsize_t>{H5S_UNLIMITED});
+  CHECK(one.chunk == std::vector<std::uint64_t>{16});
+  CHECK(one.max_dims == std::vector<std::uint64_t>{inspect::kUnlimited});
   CHECK(one.deflate == 0);
   CHECK(read_dataset(file, "/t/four").shape == std::vector<std::size_t>{0, 4});
 }
@@ -250,8 +227,8 @@ TEST_CASE("a table's own block_rows sets its chunk and when its block is written
     CHECK(read_dataset(file, "/a/x").shape.at(0) == 5);
     writer.close("complete");
   }
-  CHECK(layout_of(file, "/a/x").chunk == std::vector<hsize_t>{5});
-  CHECK(layout_of(file, "/b/x").chunk == std::vector<hsize_t>{16});
+  CHECK(layout_of(file, "/a/x").chunk == std::vector<std::uint64_t>{5});
+  CHECK(layout_of(file, "/b/x").chunk == std::vector<std::uint64_t>{16});
   const Dataset a = read_dataset(file, "/a/x");
   REQUIRE(a.shape == std::vector<std::size_t>{7, 3});
   for (int r = 0; r < 5; ++r) {
@@ -760,15 +737,12 @@ TEST_CASE("no object of a trace carries a time stamp", "[trace_writer]") {
     *t.append_row() = 1.0;
     writer.close("complete");
   }
-  const hid_t f = H5Fopen(file.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
-  REQUIRE(f >= 0);
+  const inspect::File f = inspect::File::open(file);
   for (const char* path : {"/", "/t"}) {
-    H5O_info_t info;
-    REQUIRE(H5Oget_info_by_name2(f, path, &info, H5O_INFO_TIME, H5P_DEFAULT) >= 0);
+    const inspect::ObjectTimes times = f.times(path);
     INFO(path);
-    CHECK(info.ctime == 0);
-    CHECK(info.mtime == 0);
-    CHECK(info.btime == 0);
+    CHECK(times.change == 0);
+    CHECK(times.modification == 0);
+    CHECK(times.birth == 0);
   }
-  H5Fclose(f);
 }
