@@ -127,6 +127,7 @@ void ImplicitStep::reserve(std::size_t couplings) {
   solved_.reserve(couplings);
   u0_.reserve(couplings);
   start_force_.reserve(couplings);
+  constant_.reserve(couplings);
   current_couplings_.reserve(couplings);
 }
 
@@ -135,7 +136,7 @@ int ImplicitStep::find(int body) {
   return body;
 }
 
-Vec3 ImplicitStep::relative_velocity(const State& state, const Coupling& c, const std::vector<Vec3>& v,
+inline Vec3 ImplicitStep::relative_velocity(const State& state, const Coupling& c, const std::vector<Vec3>& v,
                                      const std::vector<Vec3>& w) const {
   const auto point_velocity = [&](int body) -> Vec3 {
     if (body < 0 || island_of_[body] < 0) return Vec3::Zero();
@@ -165,6 +166,7 @@ void ImplicitStep::solve(const Model& model, const State& state, const std::vect
   }
   u0_.resize(couplings.size());
   start_force_.resize(couplings.size());
+  constant_.resize(couplings.size());
   for (std::size_t i = 0; i < couplings.size(); ++i) u0_[i] = relative_velocity(state, couplings[i], v0, w0);
   // Islands: awake bodies joined by a body point (a sleeping body stays put, as the world does).
   for (const Coupling& c : couplings) {
@@ -259,9 +261,9 @@ void ImplicitStep::solve_island(const Inputs& in, double h) {
     bool slipped = false, released = false;
     for (int i : current_couplings_) {
       const Coupling& c = couplings[i];
+      if (mode_[i] == CouplingMode::kOff) continue;
       const Vec3 u1 = relative_velocity(state, c, v1_, w1_);
-      solved_[i] = constant_force(c, start_force_[i], mode_[i], u0_[i], slide_[i]) -
-                   response_shape(c, mode_[i], slide_[i], h).times(u1);
+      solved_[i] = constant_[i] - response_shape(c, mode_[i], slide_[i], h).times(u1);
       if (c.mu < 0.0 || mode_[i] != CouplingMode::kHold) continue;
       const double f_n = c.normal.dot(solved_[i]);
       const Vec3 f_t = solved_[i] - f_n * c.normal;
@@ -367,7 +369,8 @@ void ImplicitStep::assemble_and_solve_n(const Inputs& in, int size, double h) {
     const Coupling& c = in.couplings[i];
     if (mode_[i] == CouplingMode::kOff) continue;
     const Response g = response_shape(c, mode_[i], slide_[i], h);
-    Vec3 fc = constant_force(c, start_force_[i], mode_[i], u0_[i], slide_[i]);
+    constant_[i] = constant_force(c, start_force_[i], mode_[i], u0_[i], slide_[i]);
+    Vec3 fc = constant_[i];
     if (c.a < 0) fc += g.times(c.world_velocity);   // the world side moves on: u1 = J q1 - v_world
     const bool in_b = c.b >= 0 && island_of_[c.b] >= 0;
     const bool in_a = c.a >= 0 && island_of_[c.a] >= 0;
