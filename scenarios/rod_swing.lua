@@ -62,9 +62,12 @@ local function finger(side, watch)
       local rod = sim.objects.rod
       widest = math.max(widest, swing_deg(rod))
       if sim.time > settled then
-        local x0 = hand_x(stop)   -- where the hand holds
+        -- The hand is where the fingers' HIPs are (midway between them): the script's hold, or
+        -- a device's tip, which the rod's pull moves when the hand is soft.
+        local a, b = sim.fingers.thumb.hip, sim.fingers.index.hip
+        local hand = { (a[1] + b[1]) / 2, (a[2] + b[2]) / 2, (a[3] + b[3]) / 2 }
         local p = rod.position
-        local r = math.sqrt((p[1] - x0) ^ 2 + p[2] ^ 2 + (p[3] - grip) ^ 2)
+        local r = math.sqrt((p[1] - hand[1]) ^ 2 + (p[2] - hand[2]) ^ 2 + (p[3] - hand[3]) ^ 2)
         band.lo, band.hi = math.min(band.lo, r), math.max(band.hi, r)
       end
     end
