@@ -38,18 +38,7 @@ Vec3 constant_force(const Coupling& c, const Vec3& force, CouplingMode mode, con
 // point whose normal and tangential laws are one), where S_x S_y = y x^T - (x . y) I; and rank
 // one, G = a b^T (a sliding point, a = g_n (n + mu t), b = n), where J_x^T G J_y = (J_x^T a)(J_y^T b)^T
 // and J^T v = (v, r x v).
-struct Response {
-  enum class Shape : std::uint8_t { kIsotropic, kRankOne, kGeneral } shape;
-  double g = 0.0;   // kIsotropic: N s/m
-  Vec3 a, b;        // kRankOne: G = a b^T
-  Mat3 full;        // kGeneral: G
-
-  Vec3 times(const Vec3& v) const {   // G v
-    if (shape == Shape::kIsotropic) return g * v;
-    if (shape == Shape::kRankOne) return b.dot(v) * a;
-    return full * v;
-  }
-};
+using Response = CouplingResponse;
 
 template <int N>
 void add_block(double* m, int size, int row, int col, const Response& g, const Vec3& r_x, const Vec3& r_y, double s) {
@@ -128,6 +117,7 @@ void ImplicitStep::reserve(std::size_t couplings) {
   u0_.reserve(couplings);
   start_force_.reserve(couplings);
   constant_.reserve(couplings);
+  response_.reserve(couplings);
   current_couplings_.reserve(couplings);
 }
 
@@ -167,6 +157,7 @@ void ImplicitStep::solve(const Model& model, const State& state, const std::vect
   u0_.resize(couplings.size());
   start_force_.resize(couplings.size());
   constant_.resize(couplings.size());
+  response_.resize(couplings.size());
   for (std::size_t i = 0; i < couplings.size(); ++i) u0_[i] = relative_velocity(state, couplings[i], v0, w0);
   // Islands: awake bodies joined by a body point (a sleeping body stays put, as the world does).
   for (const Coupling& c : couplings) {
@@ -263,7 +254,7 @@ void ImplicitStep::solve_island(const Inputs& in, double h) {
       const Coupling& c = couplings[i];
       if (mode_[i] == CouplingMode::kOff) continue;
       const Vec3 u1 = relative_velocity(state, c, v1_, w1_);
-      solved_[i] = constant_[i] - response_shape(c, mode_[i], slide_[i], h).times(u1);
+      solved_[i] = constant_[i] - response_[i].times(u1);
       if (c.mu < 0.0 || mode_[i] != CouplingMode::kHold) continue;
       const double f_n = c.normal.dot(solved_[i]);
       const Vec3 f_t = solved_[i] - f_n * c.normal;
@@ -368,7 +359,8 @@ void ImplicitStep::assemble_and_solve_n(const Inputs& in, int size, double h) {
   for (int i : current_couplings_) {
     const Coupling& c = in.couplings[i];
     if (mode_[i] == CouplingMode::kOff) continue;
-    const Response g = response_shape(c, mode_[i], slide_[i], h);
+    response_[i] = response_shape(c, mode_[i], slide_[i], h);
+    const Response& g = response_[i];
     constant_[i] = constant_force(c, start_force_[i], mode_[i], u0_[i], slide_[i]);
     Vec3 fc = constant_[i];
     if (c.a < 0) fc += g.times(c.world_velocity);   // the world side moves on: u1 = J q1 - v_world

@@ -167,9 +167,9 @@ int floor_contact(const Model& model, int body, BodyState& bs, Wrench& out) {
   return touching;
 }
 
-int floor_couplings(const Model& model, int body, BodyState& bs, double h, double radius, std::vector<Coupling>& out) {
+int floor_couplings(const Model& model, int body, const ContactPair& pair, BodyState& bs, double h, double radius,
+                    std::vector<Coupling>& out) {
   const BodyParams& bp = model.bodies[body];
-  const ContactPair pair = floor_pair(model, body);
   const double floor_z = model.floor.height;
   const double reach = h * h * model.gravity.norm();   // m: how far gravity alone carries a point in a step
   int appended = 0;

@@ -45,6 +45,7 @@ Simulation::Simulation(Model model)
   std::size_t floor_points = 0;
   for (const BodyParams& bp : model_.bodies) {
     floor_reach_.push_back(floor_reach(bp.shape) * (1.0 + 1e-9) + 1e-12);
+    if (model_.floor.enabled) floor_pairs_.push_back(floor_pair(model_, static_cast<int>(floor_pairs_.size())));
     floor_points += static_cast<std::size_t>(floor_point_count(bp.shape));
   }
   floor_clear_.assign(model_.bodies.size(), 0);

@@ -71,7 +71,7 @@ void Simulation::implicit_contacts(const Input& input) {
         }
         continue;
       }
-      floor_clear_[b] = floor_couplings(model_, static_cast<int>(b), bs, h, floor_reach_[b], couplings_) == 0 ? 1 : 0;
+      floor_clear_[b] = floor_couplings(model_, static_cast<int>(b), floor_pairs_[b], bs, h, floor_reach_[b], couplings_) == 0 ? 1 : 0;
     }
   }
   body_contacts_.couplings(model_, state_, couplings_, contact_points_);
@@ -99,13 +99,15 @@ void Simulation::implicit_solve(double pitch_change) {
   // The fingers' forces enter through their couplings: what is left of the bodies' windows is
   // what fingers pushed that are no longer in contact, and the torque of each finger's force
   // about where its contact point is now, not where it was when the GO last moved.
-  std::fill(contact_wrench_.begin(), contact_wrench_.end(), Wrench{});
+  const bool rules = model_.grasp.torsion != Torsion::kNone;   // else rules_ stay as constructed: none
+  if (rules) std::fill(contact_wrench_.begin(), contact_wrench_.end(), Wrench{});
   for (const Coupling& c : couplings_) {
     if (c.source == Coupling::Source::kFinger) {
       external_force_[c.b] -= c.force;
       external_torque_[c.b] -= (c.point - state_.bodies[c.b].position).cross(c.force);
       continue;
     }
+    if (!rules) continue;
     // The floor's and other bodies' push at the start of the step, pushing only, for the rules.
     const Vec3 f = std::max(0.0, c.normal.dot(c.force)) * c.normal;
     contact_wrench_[c.b].force += f;
@@ -115,7 +117,7 @@ void Simulation::implicit_solve(double pitch_change) {
       contact_wrench_[c.a].torque -= (c.point - state_.bodies[c.a].position).cross(f);
     }
   }
-  for (std::size_t b = 0; b < nb; ++b) {
+  for (std::size_t b = 0; rules && b < nb; ++b) {
     rules_[b] = awake_[b] ? plan_axis_rule(model_, state_, static_cast<int>(b), h, pitch_change,
                                            contact_wrench_[b].force, contact_wrench_[b].torque)
                           : AxisRule{};

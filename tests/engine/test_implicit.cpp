@@ -228,8 +228,8 @@ TEST_CASE("the floor's vertex screen drops only points the full test would drop"
         bs.angular_velocity = 200.0 * unit(rng) * Vec3(u(rng), u(rng), u(rng));
         BodyState full = bs;
         std::vector<Coupling> with_screen, without;
-        floor_couplings(m, 0, bs, h, radius, with_screen);
-        floor_couplings(m, 0, full, h, kInfinity, without);
+        floor_couplings(m, 0, floor_pair(m, 0), bs, h, radius, with_screen);
+        floor_couplings(m, 0, floor_pair(m, 0), full, h, kInfinity, without);
         REQUIRE(with_screen.size() == without.size());
         for (std::size_t i = 0; i < without.size(); ++i) {
           CHECK(with_screen[i].slot == without[i].slot);

@@ -51,4 +51,23 @@ enum class CouplingMode : std::uint8_t {
   kOff,     // the point separates: no force
 };
 
+// A coupling's response in its mode, G = (h + lead) K + C (N s/m): the force's change per unit of
+// relative velocity at the end of the step, kept in the shape that makes its products cheap:
+// isotropic, G = g I (a held point whose normal and tangential laws are one); rank one, G = a b^T
+// (a sliding point, a = g_n (n + mu t), b = n); or a general 3x3.
+struct CouplingResponse {
+  enum class Shape : std::uint8_t { kIsotropic, kRankOne, kGeneral };
+  Shape shape = Shape::kGeneral;
+  double g = 0.0;            // N s/m: kIsotropic
+  Vec3 a = Vec3::Zero();     // N s/m: kRankOne, G = a b^T
+  Vec3 b = Vec3::Zero();     // 1: kRankOne
+  Mat3 full = Mat3::Zero();  // N s/m: kGeneral
+
+  Vec3 times(const Vec3& v) const {   // G v
+    if (shape == Shape::kIsotropic) return g * v;
+    if (shape == Shape::kRankOne) return b.dot(v) * a;
+    return full * v;
+  }
+};
+
 }  // namespace graspsim

@@ -117,6 +117,7 @@ class ImplicitStep {
   std::vector<Vec3> u0_;                    // m/s, world, per coupling: relative velocity at the start
   std::vector<Vec3> constant_;              // N, world, per coupling: the constant part of its force
                                             //    in this round's mode (assemble_and_solve)
+  std::vector<CouplingResponse> response_;  // per coupling: its response in this round's mode
   std::vector<Vec3> start_force_;           // N, world, per coupling: `force`, less h/3 K u_mean under BDF2
   std::vector<Vec3> vq_, wq_;               // m/s, rad/s, per body: q0, or q^ under BDF2
   std::vector<Vec3> v_mean_, w_mean_;       // m/s, rad/s, per body under BDF2: the last step's

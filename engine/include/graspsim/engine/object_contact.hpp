@@ -59,9 +59,10 @@ int floor_contact(const Model& model, int body, BodyState& bs, Wrench& out);
 // clamps), and a point also counts while it is above the floor by less than it can close in one
 // step of length h, h (max(0, -u_n) + h |g|), so that a body arriving on the floor, or placed on
 // it with no load yet, is stopped by the step that would carry it in. Updates the points' anchors
-// as floor_contact does. `radius` (m) is at least the body's floor_reach: how far its points are
-// from its centre of mass. Returns how many were appended.
-int floor_couplings(const Model& model, int body, BodyState& bs, double h, double radius, std::vector<Coupling>& out);
+// as floor_contact does. `pair` is floor_pair(model, body); `radius` (m) is at least the body's
+// floor_reach: how far its points are from its centre of mass. Returns how many were appended.
+int floor_couplings(const Model& model, int body, const ContactPair& pair, BodyState& bs, double h, double radius,
+                    std::vector<Coupling>& out);
 
 // Body-body contact. Keeps its own FCL objects of the bodies (a dynamic AABB tree) for the
 // broadphase. Pairs of polyhedra (box, convex) get a clipped manifold (manifold.hpp); every other

@@ -84,6 +84,7 @@ class Simulation {
                                           //   and bodies at the start of the step, pushing only)
   std::vector<int> contact_points_;       // per body: body-body contact points of this step
   std::vector<double> floor_reach_;       // m, per body: farthest floor point from the centre of mass
+  std::vector<ContactPair> floor_pairs_;  // per body, with a floor: its pair with the floor (constant)
   std::vector<std::uint8_t> floor_clear_;  // per body: 1 when none of its floor points is active
   // The implicit step's buffers (sized once).
   ImplicitStep implicit_;
