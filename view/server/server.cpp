@@ -38,7 +38,12 @@ ViewServer::ViewServer(Packed packed, std::string web, int port) : impl_(std::ma
     res.set_content(p.blob, "application/octet-stream");
   });
   http.Get("/favicon.ico", [](const httplib::Request&, httplib::Response& res) { res.status = 204; });
-  http.set_file_extension_and_mimetype_mapping("js", "text/javascript");
+  // Debian's httplib compresses text/*, application/javascript and application/json replies
+  // with brotli at its highest quality when the browser accepts it: 3.3 s for three.core.js
+  // (1.5 MB) on this machine, for a page served over loopback. application/x-javascript, a
+  // JavaScript MIME type browsers accept for modules (HTML standard, "JavaScript MIME type"),
+  // is one it leaves alone.
+  http.set_file_extension_and_mimetype_mapping("js", "application/x-javascript");
   http.set_mount_point("/", web);
   if (port == 0) {
     port_ = http.bind_to_any_port("127.0.0.1");
