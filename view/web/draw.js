@@ -83,7 +83,7 @@ export class SceneView {
   }
 
   addFloor(height) {
-    const grid = new THREE.GridHelper(1.0, 50, 0x888888, 0xcfcfcf);   // 2 cm squares over 1 m
+    const grid = new THREE.GridHelper(1.0, 50, 0x777777, 0xb5b1a6);   // 2 cm squares over 1 m
     grid.rotateX(Math.PI / 2);
     grid.position.z = height;
     this.scene.add(grid);
@@ -133,7 +133,7 @@ export class SceneView {
     for (const f of this.fingers) box.expandByObject(f.go).expandByObject(f.hip);
     const centre = box.isEmpty() ? new THREE.Vector3() : box.getCenter(new THREE.Vector3());
     const size = Math.max(box.isEmpty() ? 0 : box.getSize(new THREE.Vector3()).length(), 0.05);
-    this.camera.position.set(centre.x + 0.9 * size, centre.y - 2.2 * size, centre.z + 1.1 * size);
+    this.camera.position.set(centre.x + 0.5 * size, centre.y - 1.4 * size, centre.z + 0.6 * size);
     return centre;
   }
 
