@@ -37,6 +37,9 @@ ViewServer::ViewServer(Packed packed, std::string web, int port) : impl_(std::ma
     res.set_header("Cache-Control", "no-store");
     res.set_content(p.blob, "application/octet-stream");
   });
+  // A page left open holds its keep-alive connections on the pool's threads, and stop() waits for
+  // them: 1 s of idle keeps Ctrl-C prompt (httplib's default is 5 s).
+  http.set_keep_alive_timeout(1);
   http.Get("/favicon.ico", [](const httplib::Request&, httplib::Response& res) { res.status = 204; });
   // Debian's httplib compresses text/*, application/javascript and application/json replies
   // with brotli at its highest quality when the browser accepts it: 3.3 s for three.core.js

@@ -38,8 +38,8 @@ try {
   process.exit(77);
 }
 
-function run(args) {
-  const r = spawnSync(cli, args, { encoding: 'utf8' });
+function run(args, cwd) {
+  const r = spawnSync(cli, args, { encoding: 'utf8', cwd });
   return { status: r.status, out: r.stdout + r.stderr };
 }
 function dump(trace) {
@@ -49,9 +49,9 @@ function dump(trace) {
 }
 
 // Starts `graspsim view TRACE --port 0` and resolves with { child, url } once it prints the URL.
-function serve(trace) {
+function serve(trace, cwd) {
   return new Promise((resolve, reject) => {
-    const child = spawn(cli, ['view', trace, '--port', '0'], { stdio: ['ignore', 'pipe', 'pipe'] });
+    const child = spawn(cli, ['view', trace, '--port', '0'], { stdio: ['ignore', 'pipe', 'pipe'], cwd });
     let out = '';
     const seen = (d) => {
       out += d;
@@ -217,6 +217,26 @@ async function checkCut() {
   }
 }
 
+// A trace whose scenario does not load where it is viewed (its mesh file named relative to a
+// directory that is not there): the bodies are still drawn at the trace's poses, as placeholders,
+// and the page says why.
+async function checkPlaceholder() {
+  const r = run(['run', 'scenarios/mesh_grasp.lua', '--out', join(tmp, 'relative.h5'), '--quiet'], src);
+  if (r.status !== 0) return fail(`mesh_grasp from ${src}: graspsim run exited ${r.status}: ${r.out}`);
+  const trace = dump(join(tmp, 'relative.h5'));
+  const { child, url } = await serve('relative.h5', tmp);   // from tmp, scenarios/meshes/ is not there
+  try {
+    const { page } = await openPage(url);
+    const note = await page.locator('#note').textContent();
+    check(/does not load here/.test(note) && /placeholder/.test(note), `a scenario that does not load here: the page says "${note}"`);
+    const n = trace.physics_tick.length;
+    await posesEqual(page, trace, trace.physics_tick[n - 1], n - 1, 'placeholder bodies');
+    await page.close();
+  } finally {
+    await stop(child);
+  }
+}
+
 // Bad input: exit 2, a message naming the file or the port, nothing served.
 async function checkBadInput() {
   const expect2 = (args, pattern, what) => {
@@ -242,6 +262,7 @@ try {
   await checkScenario('two_finger_lift', 'two_finger_lift.lua');
   await checkScenario('mesh_grasp', 'mesh_grasp.lua');
   await checkCut();
+  await checkPlaceholder();
   await checkBadInput();
 } catch (e) {
   fail(`unexpected: ${e.stack}`);
