@@ -118,6 +118,8 @@ Packed pack_scene(const ViewScene& s) {
     blob.add(p + "hip", f.hip, "f64");
     blob.add(p + "god_object", f.god_object, "f64");
     blob.add(p + "force", f.force, "f64");
+    blob.add(p + "surface_point", f.surface_point, "f64");
+    blob.add(p + "friction_radius", f.friction_radius, "f64");
     blob.add(p + "state", f.state, "i8");
     fingers += std::string(j ? ",\n    " : "") + "{\"name\": " + json_string(f.name) + ", \"radius\": " + number(f.radius) + "}";
   }

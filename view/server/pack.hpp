@@ -17,8 +17,9 @@ struct Packed {
 
 // Blob columns (layout entry "name"): "physics_tick", "haptic_tick" (float64, servo ticks),
 // "body/<i>/position" (float64, 3 per /physics row), "body/<i>/quaternion" (float64, 4 per row,
-// w x y z), "finger/<j>/hip", "finger/<j>/god_object", "finger/<j>/force" (float64, 3 per
-// /haptic row), "finger/<j>/state" (int8, 1 per /haptic row).
+// w x y z), "finger/<j>/hip", "finger/<j>/god_object", "finger/<j>/force",
+// "finger/<j>/surface_point" (float64, 3 per /haptic row), "finger/<j>/friction_radius"
+// (float64, 1 per row), "finger/<j>/state" (int8, 1 per row).
 Packed pack_scene(const ViewScene& scene);
 
 // `text` as a JSON string literal, quotes included.

@@ -138,7 +138,10 @@ void load_columns(ViewScene& s, const std::vector<std::string>& columns) {
   for (FingerView& f : s.fingers) {
     const std::string h = "/haptic/fingers/" + f.name + "/";
     const rec::Dataset go = column(t, h + "god_object", 3), force = column(t, h + "force", 3),
-                       state = column(t, h + "state", 1), hip = column(t, "/servo/fingers/" + f.name + "/hip", 3);
+                       state = column(t, h + "state", 1), hip = column(t, "/servo/fingers/" + f.name + "/hip", 3),
+                       surface = column(t, h + "surface_point", 3), circle = column(t, h + "friction_radius", 1);
+    f.surface_point.assign(surface.values.begin(), surface.values.begin() + 3 * nh);
+    f.friction_radius.assign(circle.values.begin(), circle.values.begin() + nh);
     f.god_object.assign(go.values.begin(), go.values.begin() + 3 * nh);
     f.force.assign(force.values.begin(), force.values.begin() + 3 * nh);
     for (std::size_t i = 0; i < nh; ++i) f.state.push_back(static_cast<std::int8_t>(state.values[i]));
@@ -169,12 +172,12 @@ ViewScene load_scene(const std::string& trace) {
       s.floor = m.floor.enabled;
       s.floor_height = m.floor.height;
       for (const BodyParams& b : m.bodies) s.bodies.push_back({b.name, true, b.shape, {}, {}});
-      for (const FingerParams& f : m.fingers) s.fingers.push_back({f.name, f.radius, {}, {}, {}, {}});
+      for (const FingerParams& f : m.fingers) s.fingers.push_back({f.name, f.radius, {}, {}, {}, {}, {}, {}});
     } else {
       // Names from the columns, shapes unknown: the page draws placeholders and says why.
       s.floor = true;
       for (const std::string& b : names_under(columns, "/physics/objects/")) s.bodies.push_back({b, false, {}, {}, {}});
-      for (const std::string& f : names_under(columns, "/haptic/fingers/")) s.fingers.push_back({f, 0.0, {}, {}, {}, {}});
+      for (const std::string& f : names_under(columns, "/haptic/fingers/")) s.fingers.push_back({f, 0.0, {}, {}, {}, {}, {}, {}});
     }
     load_columns(s, columns);
     if (s.status != "complete") s.note = cut_note(s);

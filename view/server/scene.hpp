@@ -34,6 +34,8 @@ struct FingerView {
   std::vector<double> god_object; // m, world: 3 per /haptic row
   std::vector<double> force;      // N, world: 3 per /haptic row, the demanded contact force
   std::vector<std::int8_t> state; // 1 per /haptic row: 0 free, 1 stick, 2 slip
+  std::vector<double> surface_point;   // m, world: 3 per /haptic row, the HIP on the contacted face
+  std::vector<double> friction_radius; // m: 1 per /haptic row, mu depth (the friction circle)
 };
 
 struct ViewScene {

@@ -7,6 +7,8 @@
 //   - scrubbing moves the cursor to the tick scrubbed to; playing moves it forward, pausing
 //     stops it;
 //   - a finger's colour changes at the haptic tick where the trace's contact state changes;
+//   - each finger's friction circle lies about the recorded surface point with the recorded
+//     radius mu depth;
 //   - a screenshot is not blank: background, floor and the body's colour are counted;
 // and that a cut trace is shown up to its last tick with a note, and that bad input (a missing
 // file, a file that is not a trace, a port in use) exits 2 with a message naming it.
@@ -153,6 +155,22 @@ async function checkScenario(name, scenario) {
       const a = await at(tick - 1), b = await at(tick);
       check(a.state === before && b.state === after && a.colour !== b.colour,
             `${name}: finger ${f} turns from state ${before} (${a.colour}) to ${after} (${b.colour}) at haptic tick ${tick}`);
+    }
+
+    // Friction circles in the middle of the run: about the recorded surface point, of the
+    // recorded radius mu depth (float64 passed through, so exactly), shown only in contact.
+    {
+      const tick = pt[n >> 1];
+      await hook(page, (t) => window.graspsimView.seek(t), tick);
+      let h = 0;
+      while (h + 1 < trace.haptic_tick.length && trace.haptic_tick[h + 1] <= tick) h++;
+      for (const f of await hook(page, () => window.graspsimView.fingers())) {
+        const rec = trace.fingers[f.name], state = rec.state[h];
+        const same = f.circle.visible === (state !== 0) &&
+          (state === 0 || (f.circle.radius === rec.friction_radius[h] && f.circle.centre.every((x, k) => x === rec.surface_point[h][k])));
+        check(same, `${name}: at tick ${tick} finger ${f.name}'s friction circle is the trace's (state ${state}, ` +
+                    `radius ${rec.friction_radius[h]} m about ${JSON.stringify(rec.surface_point[h])})`);
+      }
     }
 
     // Screenshot in the middle of the run: not blank.

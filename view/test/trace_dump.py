@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """What the browser test compares the page with, read by h5py (not by graspsim's own reader):
-every /physics row's tick, each body's position and quaternion, and each finger's /haptic tick
-and contact state. Usage: trace_dump.py TRACE.h5 -> JSON on stdout. A cut trace is opened in
+every /physics row's tick, each body's position and quaternion, and each finger's /haptic tick,
+contact state, surface point and friction radius. Usage: trace_dump.py TRACE.h5 -> JSON on stdout. A cut trace is opened in
 SWMR mode, as recordings/README.md says h5py must."""
 import json
 import sys
@@ -22,7 +22,9 @@ def main(path):
             "bodies": {b: {"position": physics[f"objects/{b}/position"].tolist(),
                            "quaternion": physics[f"objects/{b}/quaternion"].tolist()} for b in bodies},
             "haptic_tick": haptic["tick"].tolist(),
-            "fingers": {n: {"state": haptic[f"fingers/{n}/state"].tolist()} for n in fingers},
+            "fingers": {n: {"state": haptic[f"fingers/{n}/state"].tolist(),
+                            "surface_point": haptic[f"fingers/{n}/surface_point"].tolist(),
+                            "friction_radius": haptic[f"fingers/{n}/friction_radius"].tolist()} for n in fingers},
         }
     json.dump(out, sys.stdout)
 

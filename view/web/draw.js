@@ -53,7 +53,12 @@ function makeFinger(finger) {
   const spring = new THREE.Line(new THREE.BufferGeometry().setFromPoints([new THREE.Vector3(), new THREE.Vector3()]),
                                 new THREE.LineBasicMaterial({ color: 0x444444 }));
   const arrow = new THREE.ArrowHelper(new THREE.Vector3(1, 0, 0), new THREE.Vector3(), 0.01, 0xd81b60);
-  return { name: finger.name, go, hip, spring, arrow, colour: STATE_COLOURS[0], state: 0 };
+  // The friction circle: unit circle in its xy plane, scaled to mu depth, laid on the face.
+  const points = [];
+  for (let k = 0; k < 64; k++) points.push(new THREE.Vector3(Math.cos(k * Math.PI / 32), Math.sin(k * Math.PI / 32), 0));
+  const circle = new THREE.LineLoop(new THREE.BufferGeometry().setFromPoints(points),
+                                    new THREE.LineBasicMaterial({ color: 0xf39c12 }));
+  return { name: finger.name, go, hip, spring, arrow, circle, colour: STATE_COLOURS[0], state: 0 };
 }
 
 export class SceneView {
@@ -75,7 +80,7 @@ export class SceneView {
     this.bodies = scene.bodies.map((b) => { const g = makeBody(b); this.scene.add(g); return g; });
     this.fingers = scene.fingers.map((f) => {
       const v = makeFinger(f);
-      this.scene.add(v.go, v.hip, v.spring, v.arrow);
+      this.scene.add(v.go, v.hip, v.spring, v.arrow, v.circle);
       return v;
     });
     this.resize();
@@ -106,8 +111,9 @@ export class SceneView {
     this.bodies[i].quaternion.set(q[1], q[2], q[3], q[0]);
   }
 
-  // Finger j: HIP, god-object and force (3 each, world) and contact state (0, 1, 2).
-  setFinger(j, hip, go, force, state) {
+  // Finger j: HIP, god-object, force, surface point (3 each, world), friction radius (m) and
+  // contact state (0, 1, 2).
+  setFinger(j, hip, go, force, surface, frictionRadius, state) {
     const f = this.fingers[j];
     f.hip.position.set(hip[0], hip[1], hip[2]);
     f.go.position.set(go[0], go[1], go[2]);
@@ -122,6 +128,16 @@ export class SceneView {
       f.arrow.setDirection(new THREE.Vector3(force[0] / n, force[1] / n, force[2] / n));
       const len = n * FORCE_SCALE;
       f.arrow.setLength(len, Math.min(0.3 * len, 0.01), Math.min(0.15 * len, 0.005));
+    }
+    // The circle of radius mu depth about the surface point, in the face's plane: its normal is
+    // (surface point - HIP) / depth. Hidden while free.
+    const nx = surface[0] - hip[0], ny = surface[1] - hip[1], nz = surface[2] - hip[2];
+    const depth = Math.hypot(nx, ny, nz);
+    f.circle.visible = state !== 0 && depth > 0 && frictionRadius > 0;
+    if (f.circle.visible) {
+      f.circle.position.set(surface[0], surface[1], surface[2]);
+      f.circle.quaternion.setFromUnitVectors(new THREE.Vector3(0, 0, 1), new THREE.Vector3(nx / depth, ny / depth, nz / depth));
+      f.circle.scale.setScalar(frictionRadius);
     }
   }
 

@@ -59,7 +59,8 @@ async function start() {
     scene.bodies.forEach((b, i) => view.setBody(i, slice(col[`body/${i}/position`], p, 3), slice(col[`body/${i}/quaternion`], p, 4)));
     scene.fingers.forEach((f, j) => {
       const k = `finger/${j}/`;
-      view.setFinger(j, slice(col[k + 'hip'], h, 3), slice(col[k + 'god_object'], h, 3), slice(col[k + 'force'], h, 3), col[k + 'state'][h]);
+      view.setFinger(j, slice(col[k + 'hip'], h, 3), slice(col[k + 'god_object'], h, 3), slice(col[k + 'force'], h, 3),
+                     slice(col[k + 'surface_point'], h, 3), col[k + 'friction_radius'][h], col[k + 'state'][h]);
     });
     drawn = { tick, physicsRow: p, hapticRow: h };
     scrub.value = tick;
@@ -124,7 +125,9 @@ async function start() {
     bodies: () => view.bodies.map((g) => ({ name: g.name,
       position: [g.position.x, g.position.y, g.position.z],
       quaternion: [g.quaternion.w, g.quaternion.x, g.quaternion.y, g.quaternion.z] })),
-    fingers: () => view.fingers.map((f) => ({ name: f.name, state: f.state, colour: f.colour })),
+    fingers: () => view.fingers.map((f) => ({ name: f.name, state: f.state, colour: f.colour,
+      circle: { visible: f.circle.visible, radius: f.circle.scale.x,
+                centre: [f.circle.position.x, f.circle.position.y, f.circle.position.z] } })),
     seek: (tick) => { setPlaying(false); seek(tick); },
     play: () => setPlaying(true),
     pause: () => setPlaying(false),
