@@ -30,7 +30,7 @@ std::string root_string(const std::string& trace, const std::string& name, const
   return rec::has_attribute(trace, "/", name) ? rec::read_string_attribute(trace, "/", name) : fallback;
 }
 
-// A column of `width` values per row, the first `rows` rows of it.
+// A whole column, checked to hold `width` values per row.
 rec::Dataset column(const std::string& trace, const std::string& path, std::size_t width) {
   rec::Dataset d = rec::read_dataset(trace, path);
   const std::size_t w = d.shape.size() == 2 ? d.shape[1] : 1;

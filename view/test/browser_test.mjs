@@ -29,7 +29,13 @@ const ok = (what) => console.log(`ok: ${what}`);
 const fail = (what) => { console.log(`FAIL: ${what}`); failures++; };
 const check = (cond, what) => (cond ? ok(what) : fail(what));
 
-const { chromium } = await import(join(src, 'view/web/node_modules/playwright-core/index.mjs'));
+let chromium;
+try {
+  ({ chromium } = await import(join(src, 'view/web/node_modules/playwright-core/index.mjs')));
+} catch (e) {
+  console.log(`FAIL: playwright-core is not installed in view/web/node_modules (tools/setup.sh runs npm ci there): ${e.message}`);
+  process.exit(1);
+}
 let browser;
 try {
   browser = await chromium.launch({ executablePath: '/usr/bin/chromium', timeout: 60000,
@@ -179,10 +185,14 @@ async function checkScenario(name, scenario) {
     const png = await page.locator('#stage').screenshot();
     writeFileSync(join(tmp, `${name}.png`), png);
     const img = decodePng(png);
+    // Not background: anything 24 levels (summed over r, g, b) from #f4f4f2; the floor alone
+    // fills most of the view, so > 20% says the scene was drawn. Body-blue: blue above red by
+    // 25 levels, which only the bodies' #6b8cc7 is over an area (floor, fingers, arrows and
+    // circles are not; the z axis is a 1-pixel line), so > 1% says a body is in view (the box
+    // covers about 7%, the wedge about 3%).
     let notBackground = 0, body = 0;
     for (let i = 0; i < img.width * img.height; i++) {
       const r = img.pixels[i * img.channels], g = img.pixels[i * img.channels + 1], b = img.pixels[i * img.channels + 2];
-      // Background #f4f4f2; the bodies are blue (#6b8cc7 lit and blended with what is behind).
       if (Math.abs(r - 0xf4) + Math.abs(g - 0xf4) + Math.abs(b - 0xf2) > 24) notBackground++;
       if (b > r + 25) body++;
     }
