@@ -22,7 +22,14 @@ graspsim_packages=(
   clang libclang-rt-dev             # the Clang twin (tests/golden/test_compiler_twin.cpp), the
                                     # sanitizer build (its runtimes) and libFuzzer (README.md
                                     # "Sanitizers and fuzzing")
+  libcpp-httplib-dev                # `graspsim view`'s HTTP server (view/README.md)
+  chromium                          # the browser test of `graspsim view` (view/test), headless
 )
+# The page's packages come from the npm registry (view/web/package-lock.json): Node and npm,
+# from Debian unless the machine already has them (a Node of its own carries its own npm,
+# which Debian's npm package would conflict with).
+command -v node >/dev/null || graspsim_packages+=(nodejs)
+command -v npm >/dev/null || graspsim_packages+=(npm)
 
 graspsim_install_missing() {
   local missing=() p
@@ -86,7 +93,24 @@ graspsim_use_sanitize_build() {
                        -DGRASPSIM_COMPILER_TWIN_CLI="$main_build/tools/graspsim")
 }
 
+# The page's npm packages (three.js, and playwright-core for its test) in view/web/node_modules,
+# installed exactly from the lock file when they are missing or older than it.
+graspsim_npm_ci() {
+  local web="$graspsim_root/view/web" log
+  [ -f "$web/node_modules/.package-lock.json" ] &&
+    [ ! "$web/package-lock.json" -nt "$web/node_modules/.package-lock.json" ] && return 0
+  echo "graspsim: installing the viewer's npm packages in $web (npm ci)" >&2
+  log=$(mktemp /tmp/graspsim-npm.XXXXXX.log)
+  if (cd "$web" && npm ci --no-audit --no-fund) >"$log" 2>&1; then
+    rm -f "$log"
+  else
+    cat "$log" >&2
+    echo "graspsim: npm ci in $web failed (log: $log)" >&2
+    return 1
+  fi
+}
+
 # graspsim_setup [TARGET...]
 graspsim_setup() {
-  graspsim_install_missing && graspsim_build "$@"
+  graspsim_install_missing && graspsim_npm_ci && graspsim_build "$@"
 }

@@ -19,6 +19,7 @@
 #include "app/run_budget.hpp"
 #include "cli/repair.hpp"
 #include "cli/replay.hpp"
+#include "cli/view.hpp"
 #include "cli/report.hpp"
 #include "graspsim_version.hpp"
 #include "graspsim/recordings/trace_writer.hpp"
@@ -38,6 +39,7 @@ constexpr const char* kUsage =
     "                [--device FINGER=SPEC]... [--jitter A [--jitter-seed N]] [--refuse-unstable]\n"
     "       graspsim replay TRACE.h5 [--out NEW.h5] [--set NAME=VALUE]...\n"
     "       graspsim repair TRACE.h5\n"
+    "       graspsim view TRACE.h5 [--port N] [--open]\n"
     "       graspsim compare A.h5 B.h5 [--atol X] [--rtol X] [--tol PATTERN=ATOL[,RTOL]]...\n"
     "                [--bitwise] [--attributes] [--all-ticks] [--all] [--json]\n"
     "       graspsim --help | --version\n";
@@ -109,7 +111,11 @@ constexpr const char* kHelp =
     "usage: graspsim compare A.h5 B.h5 [options]   (graspsim compare --help for more)\n"
     "\n"
     "Compares two traces tick by tick and names the first tick, time, quantity, object or\n"
-    "finger and component where they part. Exit status 0 same, 1 different, 2 bad input.\n";
+    "finger and component where they part. Exit status 0 same, 1 different, 2 bad input.\n"
+    "\n"
+    "usage: graspsim view TRACE.h5 [--port N] [--open]   (graspsim view --help for more)\n"
+    "\n"
+    "Shows a trace in 3D in the browser, served on 127.0.0.1 until Ctrl-C.\n";
 
 constexpr const char* kCompareHelp =
     "usage: graspsim compare A.h5 B.h5 [options]\n"
@@ -483,5 +489,6 @@ int main(int argc, char** argv) {
   }
   if (command == "repair") return graspsim::cli::repair_command({args.begin() + 1, args.end()});
   if (command == "compare") return compare_command({args.begin() + 1, args.end()});
+  if (command == "view") return graspsim::cli::view_command({args.begin() + 1, args.end()});
   return bad_input("unknown command '" + command + "'\n" + kUsage + "Try 'graspsim --help'.");
 }

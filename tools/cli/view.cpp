@@ -1,0 +1,131 @@
+// `graspsim view`: reads the trace, packs it, serves the page until a stop signal.
+#include "cli/view.hpp"
+
+#include <pthread.h>
+#include <signal.h>
+#include <spawn.h>
+
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <iostream>
+#include <memory>
+#include <thread>
+
+#include "cli/report.hpp"
+#include "view/server/server.hpp"
+
+extern char** environ;
+
+namespace graspsim::cli {
+namespace {
+
+constexpr int kDefaultPort = 8717;
+
+constexpr const char* kViewHelp =
+    "usage: graspsim view TRACE.h5 [--port N] [--open]\n"
+    "\n"
+    "Shows a trace in 3D in the browser: serves a page on 127.0.0.1, prints its URL and runs\n"
+    "until Ctrl-C. The page draws the floor, every body with its shape (from the trace's own\n"
+    "scenario), and per finger the HIP, the god-object (a sphere of the pad radius) coloured\n"
+    "free / stick / slip, the friction circle in contact (radius mu depth about the surface\n"
+    "point) and the force on the finger as an arrow (1 cm per N); a timeline plays, pauses,\n"
+    "changes speed (0.1x to 10x), scrubs and steps one physics tick. Drag to\n"
+    "orbit, right-drag to pan, wheel to zoom. A cut trace (a run killed or stopped early) is\n"
+    "shown up to its last tick, with a note. Nothing is fetched beyond 127.0.0.1.\n"
+    "\n"
+    "options:\n"
+    "  --port N   port on 127.0.0.1 (default 8717; 0: any free port, printed)\n"
+    "  --open     open the page with xdg-open as well\n"
+    "  -h, --help this help\n"
+    "\n"
+    "exit status: 0 stopped by Ctrl-C (SIGINT), SIGTERM or SIGHUP; 2 bad input: bad arguments,\n"
+    "a missing file, a file that is not a graspsim trace or holds no physics tick, a port that\n"
+    "is in use, or the page's files missing from the build (nothing is served then).\n";
+
+int bad(const std::string& message) {
+  std::cerr << "graspsim view: " << message << "\n";
+  return kExitBadInput;
+}
+
+void open_browser(const std::string& url) {
+  pid_t pid = 0;
+  const char* argv[] = {"xdg-open", url.c_str(), nullptr};
+  if (posix_spawnp(&pid, "xdg-open", nullptr, nullptr, const_cast<char* const*>(argv), environ) != 0)
+    std::cerr << "graspsim view: --open: xdg-open could not be started; open " << url << " yourself\n";
+}
+
+}  // namespace
+
+int view_command(const std::vector<std::string>& args) {
+  std::string trace;
+  int port = kDefaultPort;
+  bool open = false;
+  for (std::size_t i = 0; i < args.size(); ++i) {
+    const std::string& a = args[i];
+    if (a == "-h" || a == "--help") {
+      std::cout << kViewHelp;
+      return kExitOk;
+    } else if (a == "--port") {
+      const std::string v = i + 1 < args.size() ? args[++i] : "";
+      char* end = nullptr;
+      const long p = std::strtol(v.c_str(), &end, 10);
+      if (v.empty() || *end != '\0' || p < 0 || p > 65535)
+        return bad("--port needs a port number from 0 to 65535 (got '" + v + "')");
+      port = static_cast<int>(p);
+    } else if (a == "--open") {
+      open = true;
+    } else if (a.rfind("-", 0) == 0) {
+      return bad("unknown option '" + a + "'\nusage: graspsim view TRACE.h5 [--port N] [--open]");
+    } else if (trace.empty()) {
+      trace = a;
+    } else {
+      return bad("one trace at a time (got '" + trace + "' and '" + a + "')");
+    }
+  }
+  if (trace.empty()) return bad("view needs a trace file\nusage: graspsim view TRACE.h5 [--port N] [--open]");
+
+  // Stop signals are taken by one thread (sigwait), blocked in every other, the server's
+  // workers included: they are created after this.
+  sigset_t stop;
+  sigemptyset(&stop);
+  for (const int s : {SIGINT, SIGTERM, SIGHUP}) sigaddset(&stop, s);
+  pthread_sigmask(SIG_BLOCK, &stop, nullptr);
+
+  const auto t0 = std::chrono::steady_clock::now();
+  std::unique_ptr<view::ViewServer> server;
+  view::Packed packed;
+  std::size_t physics_rows = 0;
+  double shown = 0.0;
+  try {
+    const std::string web = view::web_folder();
+    const view::ViewScene scene = view::load_scene(trace);
+    physics_rows = scene.physics_tick.size();
+    shown = static_cast<double>(scene.physics_tick.back()) / scene.rate_servo;
+    packed = view::pack_scene(scene);
+    if (!scene.note.empty()) std::cerr << "graspsim view: note: " << scene.note << "\n";
+    const std::size_t blob_bytes = packed.blob.size();
+    server = std::make_unique<view::ViewServer>(std::move(packed), web, port);
+    const double read_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    std::printf("graspsim view: %s: %zu physics ticks, t = 0 to %.3f s (%.1f MB for the page, read in %.2f s)\n",
+                trace.c_str(), physics_rows, shown, blob_bytes / 1e6, read_s);
+  } catch (const view::ViewError& e) {
+    return bad(e.what());
+  }
+  std::printf("  url  %s  (Ctrl-C to stop)\n", server->url().c_str());
+  std::fflush(stdout);
+  if (open) open_browser(server->url());
+
+  std::thread waiter([&] {
+    int signal = 0;
+    sigwait(&stop, &signal);
+    server->stop();
+  });
+  const bool served = server->serve();
+  if (!served) pthread_kill(waiter.native_handle(), SIGTERM);   // let the waiter return
+  waiter.join();
+  if (!served) return bad("serving " + server->url() + " failed");
+  return kExitOk;
+}
+
+}  // namespace graspsim::cli

@@ -1,0 +1,193 @@
+// A trace read for the viewer: checks, the scenario's shapes, the animated columns cut to the
+// ticks every table holds.
+#include "view/server/scene.hpp"
+
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+#include <optional>
+#include <set>
+#include <sstream>
+
+#include "graspsim/recordings/trace_reader.hpp"
+#include "graspsim/recordings/trace_recorder.hpp"
+#include "graspsim/scripting/scenario.hpp"
+
+namespace graspsim::view {
+namespace {
+
+namespace rec = recordings;
+
+std::vector<std::string> lines_of(const std::string& text) {
+  std::vector<std::string> lines;
+  std::istringstream in(text);
+  for (std::string line; std::getline(in, line);)
+    if (!line.empty()) lines.push_back(line);
+  return lines;
+}
+
+std::string root_string(const std::string& trace, const std::string& name, const std::string& fallback = "") {
+  return rec::has_attribute(trace, "/", name) ? rec::read_string_attribute(trace, "/", name) : fallback;
+}
+
+// A whole column, checked to hold `width` values per row.
+rec::Dataset column(const std::string& trace, const std::string& path, std::size_t width) {
+  rec::Dataset d = rec::read_dataset(trace, path);
+  const std::size_t w = d.shape.size() == 2 ? d.shape[1] : 1;
+  if (w != width || d.shape.empty())
+    throw ViewError(trace + ": " + path + ": expected " + std::to_string(width) + " values per row");
+  return d;
+}
+
+std::vector<std::int64_t> ticks(const std::string& trace, const std::string& table) {
+  const rec::Dataset d = column(trace, "/" + table + "/tick", 1);
+  return {d.values.begin(), d.values.end()};
+}
+
+// The scenario the trace recorded, with its overrides; nullopt (and `why`) when it does not load
+// here (a mesh file not found from this directory, a scenario this graspsim no longer reads).
+std::optional<scripting::Scenario> recorded_scenario(const std::string& trace, std::string& why) {
+  if (!rec::has_attribute(trace, "/", "scenario_source")) {
+    why = "the trace holds no scenario_source";
+    return std::nullopt;
+  }
+  scripting::LoadOptions load;
+  load.sets = lines_of(root_string(trace, "overrides"));
+  if (!rec::has_attribute(trace, "/", "integrator")) load.sets.insert(load.sets.begin(), "integrator=paper");
+  const std::string path = root_string(trace, "scenario_path", trace);
+  try {
+    return scripting::Scenario::load_source(rec::read_string_attribute(trace, "/", "scenario_source"), path, load);
+  } catch (const std::exception& e) {
+    why = e.what();
+    return std::nullopt;
+  }
+}
+
+// Names below "/<table>/<group>/" among the trace's columns, sorted.
+std::vector<std::string> names_under(const std::vector<std::string>& columns, const std::string& prefix) {
+  std::set<std::string> names;
+  for (const std::string& c : columns) {
+    if (c.rfind(prefix, 0) != 0) continue;
+    const std::string rest = c.substr(prefix.size());
+    names.insert(rest.substr(0, rest.find('/')));
+  }
+  return {names.begin(), names.end()};
+}
+
+std::string cut_note(const ViewScene& s) {
+  const double shown = s.physics_tick.empty() ? 0.0 : static_cast<double>(s.physics_tick.back()) / s.rate_servo;
+  char span[160];
+  std::snprintf(span, sizeof span, "shown up to its last tick, t = %.3f s of %.3f s", shown, s.duration);
+  if (s.status == "running")
+    return std::string("This trace was cut (status 'running': its run was killed, or is still writing it); ") + span + ".";
+  if (s.status.rfind("cut", 0) == 0) return "This trace was cut and repaired (status '" + s.status + "'); " + span + ".";
+  return "This run stopped early (status '" + s.status + "'); " + span + ".";
+}
+
+void require_trace(const std::string& trace) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  const fs::file_status st = fs::status(trace, ec);
+  if (ec || !fs::exists(st)) throw ViewError(trace + ": no such file");
+  if (!fs::is_regular_file(st)) throw ViewError(trace + ": not a regular file (a trace is a file)");
+  bool is_trace = false;
+  try {
+    is_trace = rec::has_attribute(trace, "/", "schema_version");
+  } catch (const rec::TraceError& e) {
+    throw ViewError(trace + ": not a graspsim trace (" + e.what() + ")");
+  }
+  if (!is_trace) throw ViewError(trace + ": not a graspsim trace (no root attribute 'schema_version')");
+  const std::int64_t schema = rec::read_int_attribute(trace, "/", "schema_version");
+  if (schema < 2 || schema > rec::kSchemaVersion)
+    throw ViewError(trace + ": schema_version " + std::to_string(schema) + " is not one this graspsim reads (2 to " +
+                    std::to_string(rec::kSchemaVersion) + ")");
+  for (const char* table : {"/physics", "/haptic", "/servo"})
+    if (!rec::has_object(trace, table)) throw ViewError(trace + ": not a graspsim trace (no table " + table + ")");
+}
+
+void load_columns(ViewScene& s, const std::vector<std::string>& columns) {
+  const std::string& t = s.trace;
+  const std::vector<std::int64_t> physics = ticks(t, "physics"), haptic = ticks(t, "haptic"), servo = ticks(t, "servo");
+  if (physics.empty()) throw ViewError(t + ": the trace holds no /physics row yet: nothing to show");
+  // The last tick every table holds (a cut trace's tables may end a flush interval apart).
+  std::int64_t last = physics.back();
+  if (!s.fingers.empty()) last = std::min({last, haptic.empty() ? -1 : haptic.back(), servo.empty() ? -1 : servo.back()});
+  if (last < physics.front()) throw ViewError(t + ": the trace's tables hold no tick in common: nothing to show");
+  const auto keep = [last](const std::vector<std::int64_t>& v) {
+    return static_cast<std::size_t>(std::upper_bound(v.begin(), v.end(), last) - v.begin());
+  };
+  const std::size_t np = keep(physics), nh = s.fingers.empty() ? 0 : keep(haptic);
+  s.physics_tick.assign(physics.begin(), physics.begin() + np);
+  s.haptic_tick.assign(haptic.begin(), haptic.begin() + nh);
+  for (BodyView& b : s.bodies) {
+    const std::string base = "/physics/objects/" + b.name + "/";
+    if (std::find(columns.begin(), columns.end(), base + "position") == columns.end())
+      throw ViewError(t + ": no column " + base + "position for body '" + b.name + "'");
+    const rec::Dataset p = column(t, base + "position", 3), q = column(t, base + "quaternion", 4);
+    b.position.assign(p.values.begin(), p.values.begin() + 3 * np);
+    b.quaternion.assign(q.values.begin(), q.values.begin() + 4 * np);
+  }
+  // Row of /servo at each kept haptic tick (servo rows are every tick from its first).
+  std::vector<std::size_t> servo_row(nh);
+  for (std::size_t i = 0; i < nh; ++i) {
+    const auto it = std::lower_bound(servo.begin(), servo.end(), s.haptic_tick[i]);
+    if (it == servo.end() || *it != s.haptic_tick[i])
+      throw ViewError(t + ": /servo has no row at haptic tick " + std::to_string(s.haptic_tick[i]));
+    servo_row[i] = static_cast<std::size_t>(it - servo.begin());
+  }
+  for (FingerView& f : s.fingers) {
+    const std::string h = "/haptic/fingers/" + f.name + "/";
+    const rec::Dataset go = column(t, h + "god_object", 3), force = column(t, h + "force", 3),
+                       state = column(t, h + "state", 1), hip = column(t, "/servo/fingers/" + f.name + "/hip", 3),
+                       surface = column(t, h + "surface_point", 3), circle = column(t, h + "friction_radius", 1);
+    f.surface_point.assign(surface.values.begin(), surface.values.begin() + 3 * nh);
+    f.friction_radius.assign(circle.values.begin(), circle.values.begin() + nh);
+    f.god_object.assign(go.values.begin(), go.values.begin() + 3 * nh);
+    f.force.assign(force.values.begin(), force.values.begin() + 3 * nh);
+    for (std::size_t i = 0; i < nh; ++i) f.state.push_back(static_cast<std::int8_t>(state.values[i]));
+    for (std::size_t i = 0; i < nh; ++i)
+      for (int k = 0; k < 3; ++k) f.hip.push_back(hip.values[3 * servo_row[i] + k]);
+  }
+}
+
+}  // namespace
+
+ViewScene load_scene(const std::string& trace) {
+  require_trace(trace);
+  ViewScene s;
+  try {
+    s.trace = trace;
+    s.status = root_string(trace, "status", "?");
+    s.rate_servo = static_cast<int>(rec::read_int_attribute(trace, "/", "rate_servo"));
+    s.rate_haptic = static_cast<int>(rec::read_int_attribute(trace, "/", "rate_haptic"));
+    s.rate_physics = static_cast<int>(rec::read_int_attribute(trace, "/", "rate_physics"));
+    if (s.rate_servo <= 0) throw ViewError(trace + ": root attribute rate_servo is not positive");
+    s.duration = rec::has_attribute(trace, "/", "duration") ? rec::read_double_attribute(trace, "/", "duration") : 0.0;
+    s.scenario_name = root_string(trace, "scenario_name", "?");
+    const std::vector<std::string> columns = rec::list_datasets(trace);
+    std::string why;
+    const std::optional<scripting::Scenario> scenario = recorded_scenario(trace, why);
+    if (scenario) {
+      const Model& m = scenario->model();
+      s.floor = m.floor.enabled;
+      s.floor_height = m.floor.height;
+      for (const BodyParams& b : m.bodies) s.bodies.push_back({b.name, true, b.shape, {}, {}});
+      for (const FingerParams& f : m.fingers) s.fingers.push_back({f.name, f.radius, {}, {}, {}, {}, {}, {}});
+    } else {
+      // Names from the columns, shapes unknown: the page draws placeholders and says why.
+      s.floor = true;
+      for (const std::string& b : names_under(columns, "/physics/objects/")) s.bodies.push_back({b, false, {}, {}, {}});
+      for (const std::string& f : names_under(columns, "/haptic/fingers/")) s.fingers.push_back({f, 0.0, {}, {}, {}, {}, {}, {}});
+    }
+    load_columns(s, columns);
+    if (s.status != "complete") s.note = cut_note(s);
+    if (!scenario)
+      s.note += (s.note.empty() ? "" : " ") + std::string("The recorded scenario does not load here (") + why +
+                "): bodies are drawn as grey placeholder cubes and the floor at z = 0.";
+  } catch (const rec::TraceError& e) {
+    throw ViewError(trace + ": cannot be read as a graspsim trace: " + e.what());
+  }
+  return s;
+}
+
+}  // namespace graspsim::view

@@ -1,0 +1,60 @@
+// What the viewer draws of a trace: the scenario's floor, bodies and fingers (from the trace's
+// own scenario_source and overrides) and the columns the page animates, read through
+// recordings/ (HDF5 stays there). view/README.md says why the server reads the trace.
+#pragma once
+
+#include <cstdint>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "graspsim/engine/shape.hpp"
+
+namespace graspsim::view {
+
+// The trace cannot be shown (a missing file, not a trace, no physics row): a message naming the
+// file and what is wrong. `graspsim view` exits 2 with it.
+class ViewError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+struct BodyView {
+  std::string name;
+  bool shape_known = false;       // false: the scenario did not load; the page draws a placeholder
+  Shape shape;                    // body frame (origin at the centre of mass)
+  std::vector<double> position;   // m, world: 3 per /physics row (centre of mass)
+  std::vector<double> quaternion; // 1: 4 per /physics row, w, x, y, z, body to world
+};
+
+struct FingerView {
+  std::string name;
+  double radius = 0.0;            // m: pad radius (0: a point)
+  std::vector<double> hip;        // m, world: 3 per /haptic row, the /servo row at that tick
+  std::vector<double> god_object; // m, world: 3 per /haptic row
+  std::vector<double> force;      // N, world: 3 per /haptic row, the demanded contact force
+  std::vector<std::int8_t> state; // 1 per /haptic row: 0 free, 1 stick, 2 slip
+  std::vector<double> surface_point;   // m, world: 3 per /haptic row, the HIP on the contacted face
+  std::vector<double> friction_radius; // m: 1 per /haptic row, mu depth (the friction circle)
+};
+
+struct ViewScene {
+  std::string trace;              // the file as given
+  std::string scenario_name;
+  std::string status;             // root `status`
+  std::string note;               // "" for a complete trace; else what the page says about it
+  int rate_servo = 0, rate_haptic = 0, rate_physics = 0;   // Hz
+  double duration = 0.0;          // s: the scenario's requested duration
+  bool floor = false;
+  double floor_height = 0.0;      // m
+  std::vector<std::int64_t> physics_tick;   // servo ticks of the /physics rows kept
+  std::vector<std::int64_t> haptic_tick;    // servo ticks of the /haptic rows kept
+  std::vector<BodyView> bodies;             // Model::bodies order
+  std::vector<FingerView> fingers;          // Model::fingers order
+};
+
+// Reads `trace`. Tables are cut to the ticks all of them hold (a cut trace's tables may differ by
+// a flush interval), so the page shows the run up to its last common tick. Throws ViewError.
+ViewScene load_scene(const std::string& trace);
+
+}  // namespace graspsim::view

@@ -1,0 +1,38 @@
+// The viewer's HTTP server (cpp-httplib, view/README.md): the page's files from a folder, the
+// scene's JSON and blob from memory, on 127.0.0.1 only.
+#pragma once
+
+#include <functional>
+#include <memory>
+#include <string>
+
+#include "view/server/pack.hpp"
+
+namespace graspsim::view {
+
+// The folder the page is served from: $GRASPSIM_VIEW_WEB if set, else the build's copy
+// (<build>/view/web). Throws ViewError naming the folder when the page's files are not there.
+std::string web_folder();
+
+class ViewServer {
+ public:
+  // Binds 127.0.0.1:`port` (0: any free port). Throws ViewError when the port cannot be bound
+  // (in use, or privileged), naming it.
+  ViewServer(Packed packed, std::string web, int port);
+  ~ViewServer();
+  ViewServer(const ViewServer&) = delete;
+  ViewServer& operator=(const ViewServer&) = delete;
+
+  int port() const { return port_; }
+  std::string url() const { return "http://127.0.0.1:" + std::to_string(port_) + "/"; }
+  // Serves until stop() (from another thread). Returns false if listening failed.
+  bool serve();
+  void stop();
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+  int port_ = 0;
+};
+
+}  // namespace graspsim::view

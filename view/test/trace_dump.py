@@ -1,0 +1,33 @@
+#!/usr/bin/python3
+"""What the browser test compares the page with, read by h5py (not by graspsim's own reader):
+every /physics row's tick, each body's position and quaternion, and each finger's /haptic tick,
+contact state, surface point and friction radius. Usage: trace_dump.py TRACE.h5 -> JSON on stdout. A cut trace is opened in
+SWMR mode, as recordings/README.md says h5py must."""
+import json
+import sys
+
+import h5py
+
+
+def main(path):
+    with h5py.File(path, "r", swmr=True) as f:
+        physics = f["physics"][:]
+        haptic = f["haptic"][:]
+        names = physics.dtype.names
+        bodies = sorted({n.split("/")[1] for n in names if n.startswith("objects/")})
+        fingers = sorted({n.split("/")[1] for n in haptic.dtype.names if n.startswith("fingers/")})
+        out = {
+            "status": f.attrs["status"] if isinstance(f.attrs["status"], str) else f.attrs["status"].decode(),
+            "physics_tick": physics["tick"].tolist(),
+            "bodies": {b: {"position": physics[f"objects/{b}/position"].tolist(),
+                           "quaternion": physics[f"objects/{b}/quaternion"].tolist()} for b in bodies},
+            "haptic_tick": haptic["tick"].tolist(),
+            "fingers": {n: {"state": haptic[f"fingers/{n}/state"].tolist(),
+                            "surface_point": haptic[f"fingers/{n}/surface_point"].tolist(),
+                            "friction_radius": haptic[f"fingers/{n}/friction_radius"].tolist()} for n in fingers},
+        }
+    json.dump(out, sys.stdout)
+
+
+if __name__ == "__main__":
+    main(sys.argv[1])

@@ -1,0 +1,157 @@
+// The 3D scene of a trace: floor, bodies with their shapes, fingers (HIP, god-object, force).
+// World frame as in graspsim: metres, z up. Poses are set from the trace's float64 values as they
+// are (JavaScript numbers are float64), so a drawn pose is the recorded one to the bit.
+import * as THREE from 'three';
+
+export const STATE_COLOURS = ['#9e9e9e', '#2e9e44', '#e4572e'];   // 0 free, 1 stick, 2 slip
+const FORCE_SCALE = 0.01;       // m of arrow per N
+const POINT_PAD = 0.004;        // m: god-object radius drawn for a point pad (radius 0)
+const HIP_RADIUS = 0.002;       // m
+
+// A body's geometry in its body frame (origin at the centre of mass; cylinder and capsule
+// along body z, three.js builds them along y).
+function bodyGeometry(shape) {
+  const r = shape.radius, hl = shape.half_length, h = shape.half_extents;
+  switch (shape.kind) {
+    case 'box': return new THREE.BoxGeometry(2 * h[0], 2 * h[1], 2 * h[2]);
+    case 'sphere': return new THREE.SphereGeometry(r, 32, 16);
+    case 'cylinder': return new THREE.CylinderGeometry(r, r, 2 * hl, 32).rotateX(Math.PI / 2);
+    case 'capsule': return new THREE.CapsuleGeometry(r, 2 * hl, 8, 24).rotateX(Math.PI / 2);
+    case 'convex': case 'mesh': {
+      const g = new THREE.BufferGeometry();
+      g.setAttribute('position', new THREE.Float32BufferAttribute(shape.vertices, 3));
+      g.setIndex(shape.triangles);
+      const flat = g.toNonIndexed();   // one normal per face: facets read as facets
+      flat.computeVertexNormals();
+      return flat;
+    }
+    default: return null;
+  }
+}
+
+function makeBody(body) {
+  const group = new THREE.Group();
+  group.name = body.name;
+  let geometry = bodyGeometry(body.shape);
+  const known = geometry !== null;
+  if (!known) geometry = new THREE.BoxGeometry(0.02, 0.02, 0.02);   // placeholder: shape unknown
+  const material = new THREE.MeshStandardMaterial({
+    color: known ? 0x6b8cc7 : 0xbbbbbb, roughness: 0.6, metalness: 0.0,
+    transparent: true, opacity: known ? 0.6 : 0.5, wireframe: !known });
+  group.add(new THREE.Mesh(geometry, material));
+  if (known) group.add(new THREE.LineSegments(new THREE.EdgesGeometry(geometry, 20),
+                                              new THREE.LineBasicMaterial({ color: 0x26324a })));
+  return group;
+}
+
+function makeFinger(finger) {
+  const padRadius = finger.radius > 0 ? finger.radius : POINT_PAD;
+  const go = new THREE.Mesh(new THREE.SphereGeometry(padRadius, 24, 12),
+                            new THREE.MeshStandardMaterial({ color: STATE_COLOURS[0], roughness: 0.4 }));
+  const hip = new THREE.Mesh(new THREE.SphereGeometry(HIP_RADIUS, 12, 8),
+                             new THREE.MeshBasicMaterial({ color: 0x222222 }));
+  const spring = new THREE.Line(new THREE.BufferGeometry().setFromPoints([new THREE.Vector3(), new THREE.Vector3()]),
+                                new THREE.LineBasicMaterial({ color: 0x444444 }));
+  const arrow = new THREE.ArrowHelper(new THREE.Vector3(1, 0, 0), new THREE.Vector3(), 0.01, 0xd81b60);
+  // The friction circle: unit circle in its xy plane, scaled to mu depth, laid on the face.
+  const points = [];
+  for (let k = 0; k < 64; k++) points.push(new THREE.Vector3(Math.cos(k * Math.PI / 32), Math.sin(k * Math.PI / 32), 0));
+  const circle = new THREE.LineLoop(new THREE.BufferGeometry().setFromPoints(points),
+                                    new THREE.LineBasicMaterial({ color: 0xf39c12 }));
+  return { name: finger.name, go, hip, spring, arrow, circle, colour: STATE_COLOURS[0], state: 0 };
+}
+
+export class SceneView {
+  constructor(container, scene) {
+    this.container = container;
+    this.scene = new THREE.Scene();
+    this.scene.background = new THREE.Color(0xf4f4f2);
+    this.renderer = new THREE.WebGLRenderer({ antialias: true, preserveDrawingBuffer: true });
+    this.renderer.setPixelRatio(window.devicePixelRatio);
+    container.appendChild(this.renderer.domElement);
+    this.camera = new THREE.PerspectiveCamera(40, 1, 0.001, 100);
+    this.camera.up.set(0, 0, 1);
+    this.scene.add(new THREE.HemisphereLight(0xffffff, 0x8a8a80, 2.0));
+    const sun = new THREE.DirectionalLight(0xffffff, 1.5);
+    sun.position.set(0.5, -1, 2);
+    this.scene.add(sun);
+    if (scene.floor.enabled) this.addFloor(scene.floor.height);
+    this.scene.add(new THREE.AxesHelper(0.05));
+    this.bodies = scene.bodies.map((b) => { const g = makeBody(b); this.scene.add(g); return g; });
+    this.fingers = scene.fingers.map((f) => {
+      const v = makeFinger(f);
+      this.scene.add(v.go, v.hip, v.spring, v.arrow, v.circle);
+      return v;
+    });
+    this.resize();
+    window.addEventListener('resize', () => this.resize());
+  }
+
+  addFloor(height) {
+    const grid = new THREE.GridHelper(1.0, 50, 0x777777, 0xb5b1a6);   // 2 cm squares over 1 m
+    grid.rotateX(Math.PI / 2);
+    grid.position.z = height;
+    this.scene.add(grid);
+    const plane = new THREE.Mesh(new THREE.PlaneGeometry(1.0, 1.0),
+                                 new THREE.MeshStandardMaterial({ color: 0xe6e2d8, roughness: 1 }));
+    plane.position.z = height - 1e-4;   // under the grid lines, so they are not hidden
+    this.scene.add(plane);
+  }
+
+  resize() {
+    const w = this.container.clientWidth, h = this.container.clientHeight;
+    this.renderer.setSize(w, h);
+    this.camera.aspect = w / Math.max(h, 1);
+    this.camera.updateProjectionMatrix();
+  }
+
+  // Body i at position p (3) and quaternion q (w, x, y, z).
+  setBody(i, p, q) {
+    this.bodies[i].position.set(p[0], p[1], p[2]);
+    this.bodies[i].quaternion.set(q[1], q[2], q[3], q[0]);
+  }
+
+  // Finger j: HIP, god-object, force, surface point (3 each, world), friction radius (m) and
+  // contact state (0, 1, 2).
+  setFinger(j, hip, go, force, surface, frictionRadius, state) {
+    const f = this.fingers[j];
+    f.hip.position.set(hip[0], hip[1], hip[2]);
+    f.go.position.set(go[0], go[1], go[2]);
+    f.spring.geometry.setFromPoints([f.go.position, f.hip.position]);
+    f.state = state;
+    f.colour = STATE_COLOURS[state] ?? '#000000';
+    f.go.material.color.set(f.colour);
+    const n = Math.hypot(force[0], force[1], force[2]);
+    f.arrow.visible = n > 1e-9;
+    if (f.arrow.visible) {
+      f.arrow.position.copy(f.go.position);
+      f.arrow.setDirection(new THREE.Vector3(force[0] / n, force[1] / n, force[2] / n));
+      const len = n * FORCE_SCALE;
+      f.arrow.setLength(len, Math.min(0.3 * len, 0.01), Math.min(0.15 * len, 0.005));
+    }
+    // The circle of radius mu depth about the surface point, in the face's plane: its normal is
+    // (surface point - HIP) / depth. Hidden while free.
+    const nx = surface[0] - hip[0], ny = surface[1] - hip[1], nz = surface[2] - hip[2];
+    const depth = Math.hypot(nx, ny, nz);
+    f.circle.visible = state !== 0 && depth > 0 && frictionRadius > 0;
+    if (f.circle.visible) {
+      f.circle.position.set(surface[0], surface[1], surface[2]);
+      f.circle.quaternion.setFromUnitVectors(new THREE.Vector3(0, 0, 1), new THREE.Vector3(nx / depth, ny / depth, nz / depth));
+      f.circle.scale.setScalar(frictionRadius);
+    }
+  }
+
+  // The camera looks at what is drawn now (bodies and fingers) from the front (-y), a little
+  // above, far enough to see all of it; returns the point it looks at.
+  frame() {
+    const box = new THREE.Box3();
+    for (const g of this.bodies) box.expandByObject(g);
+    for (const f of this.fingers) box.expandByObject(f.go).expandByObject(f.hip);
+    const centre = box.isEmpty() ? new THREE.Vector3() : box.getCenter(new THREE.Vector3());
+    const size = Math.max(box.isEmpty() ? 0 : box.getSize(new THREE.Vector3()).length(), 0.05);
+    this.camera.position.set(centre.x + 0.5 * size, centre.y - 1.4 * size, centre.z + 0.6 * size);
+    return centre;
+  }
+
+  render() { this.renderer.render(this.scene, this.camera); }
+}
