@@ -21,6 +21,7 @@
 #include "cli/replay.hpp"
 #include "cli/report.hpp"
 #include "graspsim_version.hpp"
+#include "graspsim/recordings/record_selection.hpp"
 #include "graspsim/recordings/trace_writer.hpp"
 #include "graspsim/scripting/scenario.hpp"
 
@@ -36,10 +37,11 @@ using graspsim::cli::kExitTraceFault;
 constexpr const char* kUsage =
     "usage: graspsim run SCENARIO.lua [--out FILE.h5] [--duration S] [--set NAME=VALUE]...\n"
     "                [--device FINGER=SPEC]... [--jitter A [--jitter-seed N]] [--refuse-unstable]\n"
+    "                [--no-trace | --record LOOP[:EVERY],...]\n"
     "       graspsim replay TRACE.h5 [--out NEW.h5] [--set NAME=VALUE]...\n"
     "       graspsim repair TRACE.h5\n"
     "       graspsim compare A.h5 B.h5 [--atol X] [--rtol X] [--tol PATTERN=ATOL[,RTOL]]...\n"
-    "                [--bitwise] [--attributes] [--all-ticks] [--all] [--json]\n"
+    "                [--bitwise] [--attributes] [--all-ticks] [--all] [--only LOOP]... [--json]\n"
     "       graspsim --help | --version\n";
 
 constexpr const char* kHelp =
@@ -73,6 +75,14 @@ constexpr const char* kHelp =
     "  --jitter-seed N      the jitter's seed, an integer 0 to 2^63 - 1 (default 0): the same\n"
     "                       seed gives the same offsets on every machine\n"
     "  --compress N         deflate the trace at level N (1..9; default none)\n"
+    "  --no-trace           write no trace at all (no file, no writer thread); the summary\n"
+    "                       and the expectations are as with one, and set the exit status\n"
+    "  --record LOOP[:EVERY],...\n"
+    "                       record only these loops (servo, haptic, physics, devices), each\n"
+    "                       at every EVERY-th tick of its own loop (default 1), e.g.\n"
+    "                       --record physics or --record physics,servo:10; default: every loop\n"
+    "                       at every tick. Written to the trace's root attribute `record`;\n"
+    "                       `graspsim replay` needs servo (and devices) at every tick\n"
     "  --refuse-unstable    stop the run at the first unstable mode the stability check\n"
     "                       finds (as the scenario field stability = \"refuse\"), exit 2;\n"
     "                       without it each one is a warning on stderr, with its time\n"
@@ -209,7 +219,8 @@ int run_command(const std::vector<std::string>& args) {
   std::string scenario_path, out;
   graspsim::scripting::LoadOptions load;
   int compression = 0;
-  bool quiet = false, refuse_unstable = false;
+  bool quiet = false, refuse_unstable = false, no_trace = false, out_given = false, compress_given = false;
+  std::optional<graspsim::recordings::RecordSelection> record;
   std::vector<std::string> device_options;
   bool jitter_seed_given = false;
   for (std::size_t i = 0; i < args.size(); ++i) {
@@ -231,6 +242,19 @@ int run_command(const std::vector<std::string>& args) {
       if (!v || v->empty() || v->front() == '-')
         return bad_input("--out needs a file name" + (v ? " (got '" + *v + "')" : std::string()));
       out = *v;
+      out_given = true;
+    } else if (a == "--no-trace") {
+      no_trace = true;
+    } else if (a == "--record") {
+      const std::string* v = value();
+      if (!v || v->empty() || v->front() == '-')
+        return bad_input("--record needs LOOP[:EVERY],... (loops: servo, haptic, physics, devices)" +
+                         (v ? " (got '" + *v + "')" : std::string()));
+      try {
+        record = graspsim::recordings::RecordSelection::parse(*v);
+      } catch (const std::invalid_argument& e) {
+        return bad_input("--record " + *v + ": " + e.what());
+      }
     } else if (a == "--duration") {
       const std::string* v = value();
       double d = 0.0;
@@ -257,6 +281,7 @@ int run_command(const std::vector<std::string>& args) {
       if (!v || !parse_number(*v, level) || level < 1 || level > 9 || level != std::floor(level))
         return bad_input("--compress needs a level from 1 to 9");
       compression = static_cast<int>(level);
+      compress_given = true;
     } else if (a == "--quiet") {
       quiet = true;
     } else if (a == "--refuse-unstable") {
@@ -272,6 +297,9 @@ int run_command(const std::vector<std::string>& args) {
   if (scenario_path.empty()) return bad_input(std::string("run needs a scenario file\n") + kUsage);
   if (jitter_seed_given && !(load.jitter.amplitude > 0.0))
     return bad_input("--jitter-seed needs --jitter A with A > 0 (without an amplitude nothing is drawn)");
+  if (no_trace && (record || out_given || compress_given))
+    return bad_input(std::string("--no-trace writes no trace, so it takes no ") +
+                     (record ? "--record" : out_given ? "--out" : "--compress"));
 
   std::optional<graspsim::scripting::Scenario> scenario;
   try {
@@ -294,6 +322,8 @@ int run_command(const std::vector<std::string>& args) {
   options.out = out;
   options.inputs = plan.files;
   options.trace.compression = compression;
+  options.trace.write = !no_trace;
+  if (record) options.trace.record = *record;
   options.overrides = load.sets;
   options.stop.interrupt = &g_interrupt;
   options.stop.signal = &g_signal;
@@ -360,7 +390,9 @@ int run_command(const std::vector<std::string>& args) {
                 static_cast<long long>(result.physics_ticks));
     std::printf("  wall time   %.3g s (%.0fx real time)\n", result.wall,
                 result.wall > 0 ? result.simulated / result.wall : 0.0);
-    std::printf("  trace       %s (%s)\n", result.trace_path.c_str(), ec ? "?" : human_bytes(size).c_str());
+    if (no_trace) std::printf("  trace       none (--no-trace)\n");
+    else std::printf("  trace       %s (%s)%s\n", result.trace_path.c_str(), ec ? "?" : human_bytes(size).c_str(),
+                     options.trace.record.everything() ? "" : (", record " + options.trace.record.text()).c_str());
     if (scenario->jitter().amplitude > 0.0)
       std::printf("  jitter      waypoints moved by up to %g m per axis, seed %llu (trace: jitter_offsets)\n",
                   scenario->jitter().amplitude, static_cast<unsigned long long>(scenario->jitter().seed));
@@ -369,8 +401,8 @@ int run_command(const std::vector<std::string>& args) {
   if (!result.trace_error.empty()) {
     std::fprintf(stderr, "graspsim: the trace could not be written to its end: %s\n", result.trace_error.c_str());
   } else if (!result.error.empty()) {
-    std::fprintf(stderr, "graspsim: the run stopped early: %s\n  (the trace keeps every tick up to there)\n",
-                 result.error.c_str());
+    std::fprintf(stderr, "graspsim: the run stopped early: %s\n%s", result.error.c_str(),
+                 no_trace ? "" : "  (the trace keeps every tick up to there)\n");
   }
   const int failed = graspsim::cli::print_expectations(result, quiet);
   if (!result.trace_error.empty()) return kExitTraceFault;
