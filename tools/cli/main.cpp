@@ -154,12 +154,24 @@ constexpr const char* kCompareHelp =
     "                       legitimately differ. Rates and schema version must always match.\n"
     "  --all-ticks          ticks present in one trace only count as differences\n"
     "  --all                also list the datasets within tolerance, with their largest error\n"
+    "  --only LOOP[,LOOP...]\n"
+    "                       compare only these loops (repeatable): servo, haptic, physics,\n"
+    "                       devices (every /devices/FINGER) or devices/FINGER; a loop neither\n"
+    "                       trace holds is an error\n"
     "  --json               one JSON object on stdout instead of the table (fields:\n"
     "                       recordings/README.md, \"Comparing traces\")\n"
     "\n"
-    "exit status: 0 same within tolerance, 1 different, 2 unusable input (a missing, truncated\n"
-    "or non-HDF5 file, not a graspsim trace, schema versions or rates that differ, a dataset\n"
-    "in one trace only, different shapes, bad options).\n"
+    "Tables one trace holds and the other does not (/devices/FINGER of a device session\n"
+    "against its scripted run, a loop one trace did not --record) are listed as \"only in A\"\n"
+    "or \"only in B\" and not compared; the loops both hold are. Ticks one trace did not keep\n"
+    "(--record LOOP:EVERY) are counted as ticks in one trace only.\n"
+    "\n"
+    "exit status: 0 same: every compared element within tolerance (tables in one trace only do\n"
+    "not count; ticks in one trace only count only with --all-ticks, root attributes only with\n"
+    "--attributes); 1 different: some element outside the tolerance (or a counted tick or\n"
+    "attribute); 2 unusable input: a missing, truncated or non-HDF5 file, not a graspsim trace,\n"
+    "schema versions or rates that differ, no loop both traces hold, a column of a shared loop\n"
+    "in one trace only, different shapes, bad options (an --only loop neither trace holds).\n"
     "\n"
     "Why not h5diff: with the box's height changed by 1e-9 m at one physics tick of the\n"
     "two-finger lift, `h5diff -r A.h5 B.h5` prints, between blocks for every other dataset,\n"
@@ -464,6 +476,20 @@ int compare_command(const std::vector<std::string>& args) {
       options.all_ticks = true;
     } else if (a == "--all") {
       all = true;
+    } else if (a == "--only") {
+      // LOOP or LOOP,LOOP,...; repeatable. (Not a list of words up to the files: a loop and a
+      // file name cannot be told apart.)
+      const std::string* v = value();
+      if (!v || v->empty() || v->front() == '-')
+        return bad_input("--only needs a loop (servo, haptic, physics, devices or devices/<finger>)" +
+                         (v ? " (got '" + *v + "')" : std::string()));
+      for (std::size_t start = 0; start <= v->size();) {
+        const std::size_t comma = std::min(v->find(',', start), v->size());
+        const std::string loop = v->substr(start, comma - start);
+        if (loop.empty()) return bad_input("--only " + *v + ": an empty loop name");
+        options.only.push_back(loop);
+        start = comma + 1;
+      }
     } else if (a == "--json") {
       json = true;
     } else if (a.rfind("-", 0) == 0) {
