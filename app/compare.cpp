@@ -136,6 +136,14 @@ std::string compare_table(const CompareResult& r, bool all) {
     if (l.first_only_b) o << "   first only in B: tick " << *l.first_only_b;
     o << "\n";
   }
+  // Tables one trace holds and the other does not: listed, not compared, not a difference.
+  for (const auto& t : r.one_sided)
+    o << "  " << pad(t.table, 9) << "  only in " << (t.in_a ? "A" : "B") << ": not compared\n";
+  if (!opt.only.empty()) {
+    o << "  (--only";
+    for (const auto& l : opt.only) o << " " << l;
+    o << ": other loops not compared)\n";
+  }
   o << "\n";
 
   const std::int64_t differing = r.differing_datasets();
@@ -242,6 +250,14 @@ std::string compare_json(const CompareResult& r) {
       << "}";
   }
   o << "\n  ],\n";
+  o << "  \"one_sided_tables\": [";
+  for (std::size_t i = 0; i < r.one_sided.size(); ++i)
+    o << (i ? ", " : "") << "{\"table\": " << json_string(r.one_sided[i].table) << ", \"in\": \""
+      << (r.one_sided[i].in_a ? "a" : "b") << "\"}";
+  o << "],\n";
+  o << "  \"only\": [";
+  for (std::size_t i = 0; i < opt.only.size(); ++i) o << (i ? ", " : "") << json_string(opt.only[i]);
+  o << "],\n";
   o << "  \"differing_datasets\": " << r.differing_datasets() << ",\n";
   o << "  \"datasets\": [";
   for (std::size_t i = 0; i < r.datasets.size(); ++i) {

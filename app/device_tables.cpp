@@ -7,8 +7,9 @@ namespace graspsim::app {
 
 void DeviceTables::open(recordings::TraceWriter& writer, const Model& model,
                         const std::vector<std::unique_ptr<hw::Device>>& devices, const std::vector<bool>& record,
-                        std::size_t block_rows, bool counters) {
+                        std::size_t block_rows, bool counters, std::int64_t every) {
   rate_servo_ = model.rates.servo;
+  every_ = every;
   for (std::size_t f = 0; f < record.size() && f < devices.size(); ++f) {
     if (!record[f]) continue;
     const hw::Device& device = *devices[f];
@@ -26,6 +27,7 @@ void DeviceTables::open(recordings::TraceWriter& writer, const Model& model,
 
 void DeviceTables::record(std::int64_t n, double t, const std::vector<hw::DeviceSample>& samples,
                           const std::vector<hw::Vec3>& rendered, bool overrun) {
+  if (tables_.empty() || n % every_ != 0) return;
   for (Table& c : tables_) {
     const hw::Device& d = *c.device;
     // The device's own view: before any mapping (device frame), and the force it was sent.

@@ -21,11 +21,12 @@ namespace graspsim::app {
 class DeviceTables {
  public:
   // One table for each finger f with record[f] (and a device), `block_rows` rows per block;
-  // `counters`: with the `sequence` and `new_samples` columns.
+  // `counters`: with the `sequence` and `new_samples` columns; `every`: a row at every
+  // every-th servo tick (n % every == 0; --record devices:EVERY).
   void open(recordings::TraceWriter& writer, const Model& model,
             const std::vector<std::unique_ptr<hw::Device>>& devices, const std::vector<bool>& record,
-            std::size_t block_rows, bool counters);
-  // Servo tick n's row of every table: `samples` as read (world), `rendered` (N, world), and
+            std::size_t block_rows, bool counters, std::int64_t every = 1);
+  // Servo tick n's row of every table (at a kept tick): `samples` as read (world), `rendered` (N, world), and
   // whether the tick overran its deadline (a replayed device records its own flag instead).
   void record(std::int64_t n, double t, const std::vector<hw::DeviceSample>& samples,
               const std::vector<hw::Vec3>& rendered, bool overrun);
@@ -38,6 +39,7 @@ class DeviceTables {
   };
   std::vector<Table> tables_;
   int rate_servo_ = 1;   // Hz
+  std::int64_t every_ = 1;   // servo ticks between kept rows
 };
 
 }  // namespace graspsim::app

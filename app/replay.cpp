@@ -150,6 +150,34 @@ RecordedDeviceRows read_device_rows(const std::string& trace, const std::string&
   return r;
 }
 
+// What the trace holds (root `record`, `graspsim run --record`): a replay feeds every finger
+// from /servo at every servo tick, and a recorded device from /devices at every servo tick.
+// `what`: how the trace is used, for the message.
+recordings::RecordSelection replayable_selection(const std::string& trace, const std::string& what) {
+  using recordings::RecordedLoop;
+  recordings::RecordSelection held;
+  if (recordings::has_attribute(trace, "/", "record")) {
+    const std::string text = recordings::read_string_attribute(trace, "/", "record");
+    try {
+      held = recordings::RecordSelection::parse(text);
+    } catch (const std::invalid_argument& e) {
+      throw ReplayError(trace + ": root attribute 'record' ('" + text + "') cannot be read: it " + e.what());
+    }
+  }
+  const std::string recorded = trace + ": recorded with --record " + held.text() + ", ";
+  const std::string need = ": " + what + " needs every servo tick of /servo (and of /devices, where a device was "
+                           "recorded); run the scenario again without --record, or with servo (and devices) at "
+                           "EVERY 1";
+  if (!held.records(RecordedLoop::kServo)) throw ReplayError(recorded + "which holds no /servo" + need);
+  if (held.of(RecordedLoop::kServo) > 1)
+    throw ReplayError(recorded + "which keeps /servo only every " + std::to_string(held.of(RecordedLoop::kServo)) +
+                      "th tick" + need);
+  if (held.of(RecordedLoop::kDevices) > 1)
+    throw ReplayError(recorded + "which keeps /devices only every " + std::to_string(held.of(RecordedLoop::kDevices)) +
+                      "th tick" + need);
+  return held;
+}
+
 std::string required_string(const std::string& trace, const std::string& name) {
   if (!recordings::has_attribute(trace, "/", name)) {
     throw ReplayError(trace + ": root attribute '" + name + "' is missing: the trace cannot be replayed");
@@ -176,6 +204,7 @@ ReplayPlan load(const std::string& trace, const ReplayOptions& options) {
                       " is newer than this graspsim reads (" +
                       std::to_string(recordings::kSchemaVersion) + ")");
   }
+  plan.record = replayable_selection(trace, "a replay");
   plan.status = required_string(trace, "status");
   // A trace whose run scaled its rendered forces by a start ramp of its own (root `force_ramp`
   // > 0, s): the one force ramp is a device's force safety, which a run does not record, so the
@@ -313,6 +342,7 @@ RecordedFinger read_recorded_finger(const std::string& trace, const std::string&
     if (schema < 2 || schema > recordings::kSchemaVersion)
       throw ReplayError(trace + ": schema_version " + std::to_string(schema) + " cannot be replayed (this graspsim reads 2 to " +
                         std::to_string(recordings::kSchemaVersion) + ")");
+    replayable_selection(trace, "a finger replayed from it (--device FINGER=replay:TRACE)");
     const std::int64_t recorded_rate = recordings::read_int_attribute(trace, "/", "rate_servo");
     if (recorded_rate != rate_servo)
       throw ReplayError(trace + ": recorded at rate_servo = " + std::to_string(recorded_rate) + " Hz, but this run's servo rate is " +
@@ -344,6 +374,7 @@ RunOptions ReplayPlan::run_options(const std::string& out) const {
   options.out = out;
   options.overrides = overrides;
   options.stop.max_ticks = recorded_ticks;
+  options.trace.record = record;
   options.attributes.emplace_back("replay_of", replay_of());
   options.inputs.push_back({trace, "the trace replayed"});
   for (const RecordedFinger& r : fingers) {

@@ -69,6 +69,9 @@ struct ReplayPlan {
   std::string scenario_path;              // recorded scenario_path
   std::string scenario_source_hash;       // recorded scenario_source_hash
   std::vector<std::string> overrides;     // recorded overrides, then ReplayOptions::sets
+  // What the recording holds (root `record`): the replay records the same, so that the two
+  // compare table for table.
+  recordings::RecordSelection record;
   std::unique_ptr<scripting::Scenario> scenario;   // loaded from the trace's source
   std::vector<RecordedFinger> fingers;    // Model::fingers order
   std::int64_t recorded_ticks = 0;        // servo ticks with a sample for every finger
@@ -85,7 +88,7 @@ struct ReplayPlan {
 // One finger's recorded inputs from `trace` (/servo/fingers/<finger>/hip and gimbal), row n =
 // servo tick n, for a single finger replayed in another run (`--device FINGER=replay:TRACE`):
 // the trace must be a graspsim trace of schema >= 2 recorded at `rate_servo` Hz with every
-// servo tick from 0. Throws ReplayError naming the file and what is wrong (the fingers it holds
+// servo tick from 0 (root `record` with servo:1). Throws ReplayError naming the file and what is wrong (the fingers it holds
 // when `finger` is not one of them).
 RecordedFinger read_recorded_finger(const std::string& trace, const std::string& finger, int rate_servo);
 

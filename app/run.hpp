@@ -13,6 +13,7 @@
 #include "app/output_file.hpp"
 #include "app/pacer.hpp"
 #include "graspsim/hw/device.hpp"
+#include "graspsim/recordings/record_selection.hpp"
 #include "graspsim/scripting/scenario.hpp"
 
 namespace graspsim::app {
@@ -33,13 +34,16 @@ struct RunOptions {
 
   // How the trace is written (recordings/README.md "Cost").
   struct Trace {
-    bool write = true;                // false: no trace at all (the logging benchmark's baseline)
+    bool write = true;                // false: no trace at all (--no-trace; the logging benchmark's baseline)
     // true: HDF5 writing runs on a writer thread (TraceOptions::background); false: on the run
     // loop's thread (the logging benchmark compares the two). The file is the same.
     bool background_writer = true;
     std::size_t block_rows = 0;       // trace rows buffered per loop before a write, = rows per
                                       // chunk; 0: one flush interval of that loop (run_trace.cpp)
     int compression = 0;              // 0 none, 1..9 deflate level
+    // The loops written and how often (--record; root attribute `record`): default every loop
+    // at every tick. Replay needs /servo (and /devices, where a device was recorded) at every tick.
+    recordings::RecordSelection record;
   } trace;
 
   // What drives each finger, and what of it is recorded (README.md "Devices").

@@ -40,14 +40,21 @@ RunFootprint estimate_footprint(const scripting::Scenario& scenario, const RunOp
     return options.trace.block_rows > 0 ? static_cast<double>(options.trace.block_rows) : std::ceil(flush / divisor);
   };
   const recordings::TraceRecorder::Rows rows = recordings::TraceRecorder::row_sizes(model);
-  const auto table = [&](std::string name, recordings::RowSize row, double divisor) {
-    out.tables.push_back({std::move(name), row.values, row.bytes, block(divisor), std::ceil(run / divisor)});
+  // A table of a loop recorded every `every`-th tick (--record) holds one row per divisor *
+  // every servo ticks; a loop not recorded, or no trace at all (--no-trace), has none.
+  using recordings::RecordedLoop;
+  const auto table = [&](std::string name, recordings::RowSize row, double divisor, RecordedLoop loop) {
+    const auto every = static_cast<double>(options.trace.record.of(loop));
+    if (!options.trace.write || every <= 0) return;
+    out.tables.push_back({std::move(name), row.values, row.bytes, block(divisor * every), std::ceil(run / (divisor * every))});
   };
-  table("/servo", rows.servo, 1.0);
-  table("/haptic", rows.haptic, static_cast<double>(d.haptic));
-  table("/physics", rows.physics, static_cast<double>(d.physics));
+  table("/servo", rows.servo, 1.0, RecordedLoop::kServo);
+  table("/haptic", rows.haptic, static_cast<double>(d.haptic), RecordedLoop::kHaptic);
+  table("/physics", rows.physics, static_cast<double>(d.physics), RecordedLoop::kPhysics);
   for (std::size_t f = 0; f < options.devices.record.size() && f < model.fingers.size(); ++f)
-    if (options.devices.record[f]) table("/devices/" + model.fingers[f].name, recordings::DeviceRecorder::row_size(options.devices.counters), 1.0);
+    if (options.devices.record[f])
+      table("/devices/" + model.fingers[f].name, recordings::DeviceRecorder::row_size(options.devices.counters), 1.0,
+            RecordedLoop::kDevices);
   const double pool = options.trace.background_writer ? 4.0 : 1.0;   // TraceTable's blocks (trace_writer.cpp)
   double largest = -1.0;
   for (const TableFootprint& t : out.tables) {

@@ -87,9 +87,10 @@ void Run::open_devices() {
 void Run::prepare() {
   Simulation& sim = sim_.emplace(model_);
   trace_.open_tables(model_, options_.trace.block_rows, start_);
-  if (trace_.writer())
+  const std::int64_t device_every = options_.trace.record.of(recordings::RecordedLoop::kDevices);
+  if (trace_.writer() && device_every > 0)
     device_tables_.open(*trace_.writer(), model_, devices_, options_.devices.record, trace_.block_rows(),
-                        options_.devices.counters);
+                        options_.devices.counters, device_every);
   input_ = make_input(model_);
   record_ = make_tick_record(model_);
   rendered_.assign(model_.fingers.size(), Vec3::Zero());

@@ -52,7 +52,8 @@ std::int64_t flush_interval_ticks(const Model& model) {
 }
 
 RunTrace::RunTrace(const scripting::Scenario& scenario, const RunOptions& options)
-    : path_(options.out.empty() ? default_trace_name(scenario.name()) : options.out) {
+    : path_(options.out.empty() ? default_trace_name(scenario.name()) : options.out),
+      record_(options.trace.record) {
   if (!options.trace.write) {
     path_.clear();
     finished_ = true;   // nothing to abandon
@@ -80,6 +81,8 @@ RunTrace::RunTrace(const scripting::Scenario& scenario, const RunOptions& option
     set_attribute("scenario_source", scenario.source());
     set_attribute("scenario_source_hash", source_hash(scenario.source()));
     set_attribute("overrides", join_lines(options.overrides));
+    // What the trace holds (--record): compare and replay read it back.
+    set_attribute("record", options.trace.record.text());
     set_attribute("integrator", std::string(model.integrator == Integrator::kPaper ? "paper" : "implicit"));
     set_attribute("local_model", static_cast<std::int64_t>(model.local_model ? 1 : 0));
     set_attribute("parameters", join_lines(scenario.parameters()));
@@ -126,7 +129,7 @@ void RunTrace::open_tables(const Model& model, std::size_t block_rows, RunClock:
   block_rows_ = block_rows;
   flush_ticks_ = until_flush_ = flush_interval_ticks(model);
   last_flush_ = start;
-  if (writer_) recorder_.emplace(*writer_, model, block_rows > 0 ? 0 : flush_ticks_);
+  if (writer_) recorder_.emplace(*writer_, model, block_rows > 0 ? 0 : flush_ticks_, record_);
 }
 
 void RunTrace::flush_if_due(std::int64_t n) {

@@ -75,6 +75,7 @@ class RunTrace {
   void abandon();
 
   std::string path_;
+  recordings::RecordSelection record_;   // the loops written, and how often (RunOptions::Trace::record)
   std::optional<OutputClaim> claim_;   // the output path, locked; the trace is written to its partial name
   std::optional<recordings::TraceWriter> writer_;
   std::optional<recordings::TraceRecorder> recorder_;

@@ -103,26 +103,53 @@ void compare_attributes(const OpenTrace& a, const OpenTrace& b, const Attributes
   }
 }
 
-// The tables at the top of both files, which must be the same, in loop order (servo, haptic,
-// physics, then the rest by name); the three loops must be there.
-std::vector<std::string> matching_tables(const OpenTrace& a, const OpenTrace& b) {
-  std::vector<std::string> groups_a = top_groups(a), groups_b = top_groups(b);
-  for (const std::string& g : groups_a)
-    if (std::find(groups_b.begin(), groups_b.end(), g) == groups_b.end())
-      fail("group " + quoted("/" + g) + " is in " + quoted(a.name) + " but missing in " +
-           quoted(b.name));
-  for (const std::string& g : groups_b)
-    if (std::find(groups_a.begin(), groups_a.end(), g) == groups_a.end())
-      fail("group " + quoted("/" + g) + " is in " + quoted(b.name) + " but missing in " +
-           quoted(a.name));
-  std::stable_sort(groups_a.begin(), groups_a.end(), [](const std::string& x, const std::string& y) {
-    return loop_rank(x) < loop_rank(y);
+// Whether table `g` is selected by CompareOptions::only (empty: every table).
+bool selected(const std::string& g, const std::vector<std::string>& only) {
+  if (only.empty()) return true;
+  return std::any_of(only.begin(), only.end(), [&](const std::string& o) {
+    return g == o || (g.size() > o.size() && g.compare(0, o.size(), o) == 0 && g[o.size()] == '/');
   });
-  for (const char* required : {"servo", "haptic", "physics"})
-    if (std::find(groups_a.begin(), groups_a.end(), required) == groups_a.end())
-      fail("trace " + quoted(a.name) + " has no group " + quoted(std::string("/") + required) +
-           " (not a graspsim trace?)");
-  return groups_a;
+}
+
+// The selected tables both files hold, in loop order (servo, haptic, physics, then the rest by
+// name); the selected tables one file holds go to result.one_sided. Every `only` entry must
+// select a table of one file or the other, and the files must share at least one table.
+std::vector<std::string> shared_tables(const OpenTrace& a, const OpenTrace& b, const CompareOptions& options,
+                                       CompareResult& result) {
+  const std::vector<std::string> groups_a = top_groups(a), groups_b = top_groups(b);
+  const auto holds = [](const std::vector<std::string>& groups, const std::string& g) {
+    return std::find(groups.begin(), groups.end(), g) != groups.end();
+  };
+  for (const std::string& o : options.only) {
+    const auto hit = [&](const std::string& g) { return selected(g, {o}); };
+    if (std::none_of(groups_a.begin(), groups_a.end(), hit) && std::none_of(groups_b.begin(), groups_b.end(), hit))
+      fail("--only " + o + ": neither trace has a loop " + quoted(o) +
+           " (loops look like servo, haptic, physics, devices or devices/<finger>)");
+  }
+  std::vector<std::string> both, only_a, only_b;
+  for (const std::string& g : groups_a)
+    if (selected(g, options.only)) (holds(groups_b, g) ? both : only_a).push_back(g);
+  for (const std::string& g : groups_b)
+    if (selected(g, options.only) && !holds(groups_a, g)) only_b.push_back(g);
+  const auto by_loop = [](std::vector<std::string>& v) {
+    std::stable_sort(v.begin(), v.end(),
+                     [](const std::string& x, const std::string& y) { return loop_rank(x) < loop_rank(y); });
+  };
+  by_loop(both);
+  by_loop(only_a);
+  by_loop(only_b);
+  for (const std::string& g : only_a) result.one_sided.push_back({g, true});
+  for (const std::string& g : only_b) result.one_sided.push_back({g, false});
+  const auto list = [](const std::vector<std::string>& groups) {
+    std::string t;
+    for (const std::string& g : groups) t += (t.empty() ? "" : ", ") + g;
+    return t.empty() ? std::string("none") : t;
+  };
+  if (both.empty())
+    fail("the traces " + quoted(a.name) + " and " + quoted(b.name) + " share no " +
+         (options.only.empty() ? "loop" : "selected loop") + " to compare (" + quoted(a.name) + ": " +
+         list(groups_a) + "; " + quoted(b.name) + ": " + list(groups_b) + ")");
+  return both;
 }
 
 // The differing datasets first, by first tick (a cause before its consequences), then loop;
@@ -161,7 +188,7 @@ CompareResult compare_impl(const std::string& file_a, const std::string& file_b,
   compare_attributes(a, b, attrs_a, attrs_b, options, result);
 
   std::vector<bool> rule_used(options.rules.size(), false);
-  for (const std::string& g : matching_tables(a, b)) {
+  for (const std::string& g : shared_tables(a, b, options, result)) {
     const std::vector<std::string> names_a = datasets_below(a, g);
     if (!std::binary_search(names_a.begin(), names_a.end(), std::string("tick"))) {
       result.notes.push_back("group /" + g + " has no tick column and is not compared");

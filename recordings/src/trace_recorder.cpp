@@ -77,32 +77,43 @@ TraceRecorder::Rows TraceRecorder::row_sizes(const graspsim::Model& model) {
 }
 
 TraceRecorder::TraceRecorder(TraceWriter& writer, const graspsim::Model& model,
-                             std::int64_t chunk_ticks)
-    : servo_(writer.table(std::string(schema::kServo), chunk_rows(chunk_ticks, 1))),
-      haptic_(writer.table(std::string(schema::kHaptic),
-                           chunk_rows(chunk_ticks, divisors(model.rates).haptic))),
-      physics_(writer.table(std::string(schema::kPhysics),
-                            chunk_rows(chunk_ticks, divisors(model.rates).physics))),
-      servo_rate_(static_cast<double>(model.rates.servo)) {
+                             std::int64_t chunk_ticks, const RecordSelection& select)
+    : servo_rate_(static_cast<double>(model.rates.servo)),
+      servo_every_(select.of(RecordedLoop::kServo)),
+      haptic_every_(select.of(RecordedLoop::kHaptic)),
+      physics_every_(select.of(RecordedLoop::kPhysics)) {
   for (const auto& f : model.fingers) check_name("finger", f.name);
   for (const auto& b : model.bodies) check_name("object", b.name);
+  // A table's chunk covers chunk_ticks servo ticks of its kept rows.
+  const Divisors d = divisors(model.rates);
+  const auto table = [&](std::string_view name, std::int64_t every, std::int64_t divisor) -> TraceTable* {
+    return every > 0 ? &writer.table(std::string(name), chunk_rows(chunk_ticks, divisor * every)) : nullptr;
+  };
+  servo_ = table(schema::kServo, servo_every_, 1);
+  haptic_ = table(schema::kHaptic, haptic_every_, d.haptic);
+  physics_ = table(schema::kPhysics, physics_every_, d.physics);
 
-  servo_loop_ = declare(servo_, "", schema::kLoopFields);
-  haptic_loop_ = declare(haptic_, "", schema::kLoopFields);
-  physics_loop_ = declare(physics_, "", schema::kLoopFields);
-  physics_hash_ = declare(physics_, "", schema::kPhysicsFields);
+  if (servo_) servo_loop_ = declare(*servo_, "", schema::kLoopFields);
+  if (haptic_) haptic_loop_ = declare(*haptic_, "", schema::kLoopFields);
+  if (physics_) {
+    physics_loop_ = declare(*physics_, "", schema::kLoopFields);
+    physics_hash_ = declare(*physics_, "", schema::kPhysicsFields);
+  }
   for (const auto& finger : model.fingers) {
     const std::string prefix = std::string(schema::kFingers) + finger.name + "/";
-    servo_fingers_.push_back(declare(servo_, prefix, schema::kServoFingerFields));
-    haptic_fingers_.push_back(declare(haptic_, prefix, schema::kHapticFingerFields));
+    servo_fingers_.push_back(servo_ ? declare(*servo_, prefix, schema::kServoFingerFields) : 0);
+    haptic_fingers_.push_back(haptic_ ? declare(*haptic_, prefix, schema::kHapticFingerFields) : 0);
   }
-  std::string bodies;
-  for (std::size_t k = 0; k < model.bodies.size(); ++k) {
-    bodies += (k > 0 ? "\n" : "") + model.bodies[k].name;
+  if (haptic_) {
+    std::string bodies;
+    for (std::size_t k = 0; k < model.bodies.size(); ++k) {
+      bodies += (k > 0 ? "\n" : "") + model.bodies[k].name;
+    }
+    haptic_->set_attribute(".", "bodies", bodies);
   }
-  haptic_.set_attribute(".", "bodies", bodies);
   for (const auto& body : model.bodies) {
-    objects_.push_back(declare(physics_, std::string(schema::kObjects) + body.name + "/", schema::kBodyFields));
+    objects_.push_back(physics_ ? declare(*physics_, std::string(schema::kObjects) + body.name + "/", schema::kBodyFields)
+                                : 0);
   }
 }
 
@@ -117,24 +128,33 @@ void TraceRecorder::record(const graspsim::TickRecord& rec,
     throw std::invalid_argument("TraceRecorder::record: record sizes do not match the model");
   }
   const schema::LoopRow loop{rec.tick, static_cast<double>(rec.tick) / servo_rate_};
+  // Tick k of a loop is kept when k % every == 0: the countdown is 0 at kept ticks.
+  const auto kept = [](TraceTable* table, std::int64_t every, std::int64_t& wait) {
+    if (!table) return false;
+    const bool keep = wait == 0;
+    wait = keep ? every - 1 : wait - 1;
+    return keep;
+  };
 
-  double* row = servo_.append_row();
-  fill<schema::kLoopFields>(row, servo_loop_, loop);
-  for (std::size_t i = 0; i < fingers; ++i) {
-    const schema::ServoFingerRow servo{rec.servo[i].hip, rendered[i], rec.servo[i].force,
-                                       input.fingers[i].gimbal};
-    fill<schema::kServoFingerFields>(row, servo_fingers_[i], servo);
+  if (kept(servo_, servo_every_, servo_wait_)) {
+    double* row = servo_->append_row();
+    fill<schema::kLoopFields>(row, servo_loop_, loop);
+    for (std::size_t i = 0; i < fingers; ++i) {
+      const schema::ServoFingerRow servo{rec.servo[i].hip, rendered[i], rec.servo[i].force,
+                                         input.fingers[i].gimbal};
+      fill<schema::kServoFingerFields>(row, servo_fingers_[i], servo);
+    }
   }
 
-  if (rec.haptic_ran) {
-    row = haptic_.append_row();
+  if (rec.haptic_ran && kept(haptic_, haptic_every_, haptic_wait_)) {
+    double* row = haptic_->append_row();
     fill<schema::kLoopFields>(row, haptic_loop_, loop);
     for (std::size_t i = 0; i < fingers; ++i)
       fill<schema::kHapticFingerFields>(row, haptic_fingers_[i], rec.haptic[i]);
   }
 
-  if (rec.physics_ran) {
-    row = physics_.append_row();
+  if (rec.physics_ran && kept(physics_, physics_every_, physics_wait_)) {
+    double* row = physics_->append_row();
     fill<schema::kLoopFields>(row, physics_loop_, loop);
     fill<schema::kPhysicsFields>(row, physics_hash_, schema::PhysicsRow{state_hash(after)});
     for (std::size_t k = 0; k < objects_.size(); ++k)

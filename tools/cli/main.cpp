@@ -22,6 +22,7 @@
 #include "cli/view.hpp"
 #include "cli/report.hpp"
 #include "graspsim_version.hpp"
+#include "graspsim/recordings/record_selection.hpp"
 #include "graspsim/recordings/trace_writer.hpp"
 #include "graspsim/scripting/scenario.hpp"
 
@@ -37,11 +38,12 @@ using graspsim::cli::kExitTraceFault;
 constexpr const char* kUsage =
     "usage: graspsim run SCENARIO.lua [--out FILE.h5] [--duration S] [--set NAME=VALUE]...\n"
     "                [--device FINGER=SPEC]... [--jitter A [--jitter-seed N]] [--refuse-unstable]\n"
+    "                [--no-trace | --record LOOP[:EVERY],...]\n"
     "       graspsim replay TRACE.h5 [--out NEW.h5] [--set NAME=VALUE]...\n"
     "       graspsim repair TRACE.h5\n"
     "       graspsim view TRACE.h5 [--port N] [--open]\n"
     "       graspsim compare A.h5 B.h5 [--atol X] [--rtol X] [--tol PATTERN=ATOL[,RTOL]]...\n"
-    "                [--bitwise] [--attributes] [--all-ticks] [--all] [--json]\n"
+    "                [--bitwise] [--attributes] [--all-ticks] [--all] [--only LOOP]... [--json]\n"
     "       graspsim --help | --version\n";
 
 constexpr const char* kHelp =
@@ -52,7 +54,8 @@ constexpr const char* kHelp =
     "usage: graspsim run SCENARIO.lua [options]\n"
     "\n"
     "Runs a Lua scenario to its end, writes every tick of every loop (servo, haptic, physics)\n"
-    "to an HDF5 trace, and checks the scenario's expectations.\n"
+    "to an HDF5 trace (or what --record chooses, or nothing with --no-trace), and checks the\n"
+    "scenario's expectations.\n"
     "\n"
     "options:\n"
     "  --out FILE.h5        trace file (default: <scenario name>.h5 in this directory, any\n"
@@ -75,6 +78,14 @@ constexpr const char* kHelp =
     "  --jitter-seed N      the jitter's seed, an integer 0 to 2^63 - 1 (default 0): the same\n"
     "                       seed gives the same offsets on every machine\n"
     "  --compress N         deflate the trace at level N (1..9; default none)\n"
+    "  --no-trace           write no trace at all (no file, no writer thread); the summary\n"
+    "                       and the expectations are as with one, and set the exit status\n"
+    "  --record LOOP[:EVERY],...\n"
+    "                       record only these loops (servo, haptic, physics, devices), each\n"
+    "                       at every EVERY-th tick of its own loop (default 1), e.g.\n"
+    "                       --record physics or --record physics,servo:10; default: every loop\n"
+    "                       at every tick. Written to the trace's root attribute `record`;\n"
+    "                       `graspsim replay` needs servo (and devices) at every tick\n"
     "  --refuse-unstable    stop the run at the first unstable mode the stability check\n"
     "                       finds (as the scenario field stability = \"refuse\"), exit 2;\n"
     "                       without it each one is a warning on stderr, with its time\n"
@@ -150,12 +161,24 @@ constexpr const char* kCompareHelp =
     "                       legitimately differ. Rates and schema version must always match.\n"
     "  --all-ticks          ticks present in one trace only count as differences\n"
     "  --all                also list the datasets within tolerance, with their largest error\n"
+    "  --only LOOP[,LOOP...]\n"
+    "                       compare only these loops (repeatable): servo, haptic, physics,\n"
+    "                       devices (every /devices/FINGER) or devices/FINGER; a loop neither\n"
+    "                       trace holds is an error\n"
     "  --json               one JSON object on stdout instead of the table (fields:\n"
     "                       recordings/README.md, \"Comparing traces\")\n"
     "\n"
-    "exit status: 0 same within tolerance, 1 different, 2 unusable input (a missing, truncated\n"
-    "or non-HDF5 file, not a graspsim trace, schema versions or rates that differ, a dataset\n"
-    "in one trace only, different shapes, bad options).\n"
+    "Tables one trace holds and the other does not (/devices/FINGER of a device session\n"
+    "against its scripted run, a loop one trace did not --record) are listed as \"only in A\"\n"
+    "or \"only in B\" and not compared; the loops both hold are. Ticks one trace did not keep\n"
+    "(--record LOOP:EVERY) are counted as ticks in one trace only.\n"
+    "\n"
+    "exit status: 0 same: every compared element within tolerance (tables in one trace only do\n"
+    "not count; ticks in one trace only count only with --all-ticks, root attributes only with\n"
+    "--attributes); 1 different: some element outside the tolerance (or a counted tick or\n"
+    "attribute); 2 unusable input: a missing, truncated or non-HDF5 file, not a graspsim trace,\n"
+    "schema versions or rates that differ, no loop both traces hold, a column of a shared loop\n"
+    "in one trace only, different shapes, bad options (an --only loop neither trace holds).\n"
     "\n"
     "Why not h5diff: with the box's height changed by 1e-9 m at one physics tick of the\n"
     "two-finger lift, `h5diff -r A.h5 B.h5` prints, between blocks for every other dataset,\n"
@@ -215,7 +238,8 @@ int run_command(const std::vector<std::string>& args) {
   std::string scenario_path, out;
   graspsim::scripting::LoadOptions load;
   int compression = 0;
-  bool quiet = false, refuse_unstable = false;
+  bool quiet = false, refuse_unstable = false, no_trace = false, out_given = false, compress_given = false;
+  std::optional<graspsim::recordings::RecordSelection> record;
   std::vector<std::string> device_options;
   bool jitter_seed_given = false;
   for (std::size_t i = 0; i < args.size(); ++i) {
@@ -237,6 +261,19 @@ int run_command(const std::vector<std::string>& args) {
       if (!v || v->empty() || v->front() == '-')
         return bad_input("--out needs a file name" + (v ? " (got '" + *v + "')" : std::string()));
       out = *v;
+      out_given = true;
+    } else if (a == "--no-trace") {
+      no_trace = true;
+    } else if (a == "--record") {
+      const std::string* v = value();
+      if (!v || v->empty() || v->front() == '-')
+        return bad_input("--record needs LOOP[:EVERY],... (loops: servo, haptic, physics, devices)" +
+                         (v ? " (got '" + *v + "')" : std::string()));
+      try {
+        record = graspsim::recordings::RecordSelection::parse(*v);
+      } catch (const std::invalid_argument& e) {
+        return bad_input("--record " + *v + ": " + e.what());
+      }
     } else if (a == "--duration") {
       const std::string* v = value();
       double d = 0.0;
@@ -263,6 +300,7 @@ int run_command(const std::vector<std::string>& args) {
       if (!v || !parse_number(*v, level) || level < 1 || level > 9 || level != std::floor(level))
         return bad_input("--compress needs a level from 1 to 9");
       compression = static_cast<int>(level);
+      compress_given = true;
     } else if (a == "--quiet") {
       quiet = true;
     } else if (a == "--refuse-unstable") {
@@ -278,6 +316,9 @@ int run_command(const std::vector<std::string>& args) {
   if (scenario_path.empty()) return bad_input(std::string("run needs a scenario file\n") + kUsage);
   if (jitter_seed_given && !(load.jitter.amplitude > 0.0))
     return bad_input("--jitter-seed needs --jitter A with A > 0 (without an amplitude nothing is drawn)");
+  if (no_trace && (record || out_given || compress_given))
+    return bad_input(std::string("--no-trace writes no trace, so it takes no ") +
+                     (record ? "--record" : out_given ? "--out" : "--compress"));
 
   std::optional<graspsim::scripting::Scenario> scenario;
   try {
@@ -300,6 +341,8 @@ int run_command(const std::vector<std::string>& args) {
   options.out = out;
   options.inputs = plan.files;
   options.trace.compression = compression;
+  options.trace.write = !no_trace;
+  if (record) options.trace.record = *record;
   options.overrides = load.sets;
   options.stop.interrupt = &g_interrupt;
   options.stop.signal = &g_signal;
@@ -366,7 +409,9 @@ int run_command(const std::vector<std::string>& args) {
                 static_cast<long long>(result.physics_ticks));
     std::printf("  wall time   %.3g s (%.0fx real time)\n", result.wall,
                 result.wall > 0 ? result.simulated / result.wall : 0.0);
-    std::printf("  trace       %s (%s)\n", result.trace_path.c_str(), ec ? "?" : human_bytes(size).c_str());
+    if (no_trace) std::printf("  trace       none (--no-trace)\n");
+    else std::printf("  trace       %s (%s)%s\n", result.trace_path.c_str(), ec ? "?" : human_bytes(size).c_str(),
+                     options.trace.record.everything() ? "" : (", record " + options.trace.record.text()).c_str());
     if (scenario->jitter().amplitude > 0.0)
       std::printf("  jitter      waypoints moved by up to %g m per axis, seed %llu (trace: jitter_offsets)\n",
                   scenario->jitter().amplitude, static_cast<unsigned long long>(scenario->jitter().seed));
@@ -375,8 +420,8 @@ int run_command(const std::vector<std::string>& args) {
   if (!result.trace_error.empty()) {
     std::fprintf(stderr, "graspsim: the trace could not be written to its end: %s\n", result.trace_error.c_str());
   } else if (!result.error.empty()) {
-    std::fprintf(stderr, "graspsim: the run stopped early: %s\n  (the trace keeps every tick up to there)\n",
-                 result.error.c_str());
+    std::fprintf(stderr, "graspsim: the run stopped early: %s\n%s", result.error.c_str(),
+                 no_trace ? "" : "  (the trace keeps every tick up to there)\n");
   }
   const int failed = graspsim::cli::print_expectations(result, quiet);
   if (!result.trace_error.empty()) return kExitTraceFault;
@@ -438,6 +483,20 @@ int compare_command(const std::vector<std::string>& args) {
       options.all_ticks = true;
     } else if (a == "--all") {
       all = true;
+    } else if (a == "--only") {
+      // LOOP or LOOP,LOOP,...; repeatable. (Not a list of words up to the files: a loop and a
+      // file name cannot be told apart.)
+      const std::string* v = value();
+      if (!v || v->empty() || v->front() == '-')
+        return bad_input("--only needs a loop (servo, haptic, physics, devices or devices/<finger>)" +
+                         (v ? " (got '" + *v + "')" : std::string()));
+      for (std::size_t start = 0; start <= v->size();) {
+        const std::size_t comma = std::min(v->find(',', start), v->size());
+        const std::string loop = v->substr(start, comma - start);
+        if (loop.empty()) return bad_input("--only " + *v + ": an empty loop name");
+        options.only.push_back(loop);
+        start = comma + 1;
+      }
     } else if (a == "--json") {
       json = true;
     } else if (a.rfind("-", 0) == 0) {

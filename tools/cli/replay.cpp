@@ -160,9 +160,12 @@ int replay_command(const std::vector<std::string>& args, const std::atomic<bool>
   if (!outcome.comparison) {
     std::fprintf(stderr, "graspsim: cannot compare the replay with the recording: %s\n", outcome.compare_error.c_str());
   } else if (outcome.reproduced()) {
-    if (!quiet)
+    if (!quiet && outcome.state_hashes() > 0)
       std::printf("  reproduced  bit for bit: %zu datasets, state_hash equal at all %lld physics ticks\n",
                   outcome.comparison->datasets.size(), static_cast<long long>(outcome.state_hashes()));
+    else if (!quiet)
+      std::printf("  reproduced  bit for bit: %zu datasets (the recording keeps no /physics state_hash)\n",
+                  outcome.comparison->datasets.size());
   } else {
     const recordings::CompareResult& c = *outcome.comparison;
     const recordings::DatasetResult& d = c.datasets.front();   // the first to part

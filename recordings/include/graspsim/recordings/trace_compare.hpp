@@ -15,8 +15,9 @@
 namespace graspsim::recordings {
 
 // The traces cannot be compared: a file missing or not HDF5 or truncated, not a graspsim
-// trace, schema versions or rates that differ, a dataset in one trace only, different widths or
-// element kinds, a --tol pattern that matches nothing. what() names the file and the dataset.
+// trace, schema versions or rates that differ, no table both hold (after `only`), a column of a
+// shared table in one trace only, different widths or element kinds, a --tol pattern or an
+// `only` loop that matches nothing. what() names the file and the dataset.
 class CompareInputError : public TraceError {
  public:
   using TraceError::TraceError;
@@ -41,6 +42,10 @@ struct CompareOptions {
   bool bitwise = false;                   // equal only if the stored bits are (tolerances unused)
   bool attributes = false;                // root attribute differences count as differences
   bool all_ticks = false;                 // ticks present in one trace only count as differences
+  // Compare only these loops (--only): a table is selected when its path is one of them or
+  // lies below one ("physics"; "devices" for every /devices/<finger>, or "devices/index").
+  // Empty: every table.
+  std::vector<std::string> only;
   std::size_t block_rows = 65536;         // rows read per hyperslab
 };
 
@@ -91,12 +96,21 @@ struct AttributeDifference {
   bool counted = false;              // counts as a difference (CompareOptions::attributes)
 };
 
+// A table (loop) that one trace holds and the other does not: a device table of a device
+// session against its scripted run, a loop one trace did not record (--record). Listed; it does
+// not make the input unusable, and it is not a difference.
+struct OneSidedTable {
+  std::string table;   // "devices/index" (no leading '/')
+  bool in_a = true;    // held by A (else by B)
+};
+
 struct CompareResult {
   std::string file_a, file_b;
   CompareOptions options;                       // what was asked
   std::int64_t schema_version = 0;
   std::int64_t rate_servo = 0, rate_haptic = 0, rate_physics = 0;   // Hz
   std::vector<LoopAlignment> loops;             // servo, haptic, physics, then any other table
+  std::vector<OneSidedTable> one_sided;         // selected tables in one trace only, in loop order
   std::vector<DatasetResult> datasets;          // the differing ones first, by first divergence
                                                 // (tick, then time, then path), then by path
   std::vector<AttributeDifference> attributes;  // by name

@@ -11,6 +11,7 @@
 #include "graspsim/engine/model.hpp"
 #include "graspsim/engine/record.hpp"
 #include "graspsim/engine/state.hpp"
+#include "graspsim/recordings/record_selection.hpp"
 #include "graspsim/recordings/trace_writer.hpp"
 
 namespace graspsim::recordings {
@@ -41,10 +42,13 @@ class TraceRecorder {
   // chunk (and write block) covers that many servo ticks, i.e. chunk_ticks / (servo ticks per
   // tick of its loop) rows, rounded up; a runner that flushes every chunk_ticks ticks then
   // writes each chunk once, whole. 0: TraceOptions::block_rows rows for every table.
-  TraceRecorder(TraceWriter& writer, const graspsim::Model& model, std::int64_t chunk_ticks = 0);
+  // `select`: the loops declared and how often each keeps a row (the /devices entry is the
+  // runner's, DeviceRecorder); a loop it does not record has no table at all.
+  TraceRecorder(TraceWriter& writer, const graspsim::Model& model, std::int64_t chunk_ticks = 0,
+                const RecordSelection& select = {});
 
   // Appends one /servo row, plus a /haptic row if rec.haptic_ran and a /physics row if
-  // rec.physics_ran. `rendered` (one per finger): the force each device actually rendered after
+  // rec.physics_ran, each only if its loop is recorded and this is one of its kept ticks. `rendered` (one per finger): the force each device actually rendered after
   // clamping (N, world). `input`: the device input the step was given (its gimbal angles go to
   // /servo, so the trace alone can replay the run). `after`: the State after the step, whose
   // state_hash goes to /physics/state_hash. time = tick / servo rate, computed from the tick,
@@ -55,10 +59,14 @@ class TraceRecorder {
               const graspsim::Input& input, const graspsim::State& after);
 
  private:
-  TraceTable& servo_;
-  TraceTable& haptic_;
-  TraceTable& physics_;
+  TraceTable* servo_;     // null: the loop is not recorded
+  TraceTable* haptic_;
+  TraceTable* physics_;
   double servo_rate_;   // Hz
+  // Decimation (RecordSelection::every): ticks of each loop to its next kept row, a countdown
+  // rather than a division per tick.
+  std::int64_t servo_every_, haptic_every_, physics_every_;
+  std::int64_t servo_wait_ = 0, haptic_wait_ = 0, physics_wait_ = 0;
   // Offsets into a row of each record's first column; its fields follow it in table order
   // (trace_schema.hpp).
   std::size_t servo_loop_ = 0, haptic_loop_ = 0, physics_loop_ = 0;   // tick, time
