@@ -1,6 +1,7 @@
 // RecordSelection: the --record argument parsed, and the root attribute `record` written and read.
 #include "graspsim/recordings/record_selection.hpp"
 
+#include <numeric>
 #include <stdexcept>
 
 namespace graspsim::recordings {
@@ -70,6 +71,16 @@ RecordSelection RecordSelection::from_attribute(const std::optional<std::string>
     return none;
   }
   return parse(*value);
+}
+
+RecordSelection RecordSelection::thinned(std::int64_t stride, const std::array<std::int64_t, 3>& period) const {
+  RecordSelection out = *this;
+  for (std::size_t l = 0; l < period.size(); ++l) {
+    if (every[l] <= 0) continue;
+    // Loop tick k sits at servo tick k period: a multiple of the stride every stride / gcd ticks.
+    out.every[l] = std::lcm(every[l], stride / std::gcd(stride, period[l]));
+  }
+  return out;
 }
 
 }  // namespace graspsim::recordings

@@ -2,9 +2,13 @@
 #include "graspsim/recordings/trace_decimate.hpp"
 
 #include <algorithm>
+#include <array>
+#include <optional>
 #include <filesystem>
 #include <system_error>
 
+#include "graspsim/recordings/record_selection.hpp"
+#include "graspsim/recordings/trace_reader.hpp"
 #include "graspsim/recordings/trace_writer.hpp"
 #include "h5.hpp"
 #include "h5_checks.hpp"
@@ -221,12 +225,26 @@ void decimate_trace(const std::string& in, const std::string& out, const Decimat
   if (options.stride < 1) throw TraceError("cannot decimate " + where + ": stride " +
                                            std::to_string(options.stride) + " is not a positive number of ticks");
   const std::string temporary = out + ".part";
+  // What the copy holds, in its root attribute `record`, from the source's and its rates (a
+  // trace without rates is not a run's: its `record`, if any, is copied as it is).
+  std::optional<std::string> record;
+  if (has_attribute(in, "/", "rate_servo") && has_attribute(in, "/", "rate_haptic") &&
+      has_attribute(in, "/", "rate_physics")) {
+    const std::int64_t servo = read_int_attribute(in, "/", "rate_servo");
+    const std::array<std::int64_t, 3> period{1, servo / read_int_attribute(in, "/", "rate_haptic"),
+                                             servo / read_int_attribute(in, "/", "rate_physics")};
+    const RecordSelection source = RecordSelection::from_attribute(
+        has_attribute(in, "/", "record") ? std::optional<std::string>(read_string_attribute(in, "/", "record"))
+                                         : std::nullopt);
+    record = source.thinned(options.stride, period).text();
+  }
   {
     h5::Lock lock;
     h5::Quiet quiet;
     h5::OpenFile src = h5::open_read_only(in, where);
     Handle dst = create_copy(temporary);
     copy_attributes(src.file.get(), dst.get(), where);
+    if (record) h5::write_string_attribute(dst.get(), "record", *record, "'" + temporary + "'");
     for (const auto& [name, value] : options.root_strings)
       h5::write_string_attribute(dst.get(), name, value, "'" + temporary + "'");
     const Copier copier{in, options.compression};

@@ -3,11 +3,13 @@
 // any other table (/devices/<finger>) and every attribute are copied whole.
 #include <catch2/catch.hpp>
 
+#include <array>
 #include <cstdint>
 #include <filesystem>
 #include <string>
 #include <vector>
 
+#include "graspsim/recordings/record_selection.hpp"
 #include "graspsim/recordings/trace_decimate.hpp"
 #include "graspsim/recordings/trace_reader.hpp"
 #include "graspsim/recordings/trace_writer.hpp"
@@ -103,4 +105,51 @@ TEST_CASE("decimation refuses a stride below 1 and an input that is not a trace,
   }
   CHECK_THROWS_AS(decimate_trace(tmp_path("no_such_trace.h5"), small, {}), TraceError);
   CHECK_FALSE(std::filesystem::exists(small));
+}
+
+TEST_CASE("a decimated trace's record attribute says which ticks it holds", "[trace_decimate]") {
+  // Law: a loop of period d servo ticks, recorded every e-th of its ticks, keeps at the servo
+  // ticks that are multiples of the stride S every lcm(e, S / gcd(S, d))-th of its ticks. A
+  // golden of a 3000 / 500 / 50 Hz run at S = 60: servo every 60th, haptic (d = 6) every 10th,
+  // physics (d = 60) every one; at S = 6 of a 3000 / 500 / 1000 Hz run, physics (d = 3) every
+  // 2nd. /devices is copied whole. Checked against the rows the copy actually holds.
+  CHECK(RecordSelection{}.thinned(60, {1, 6, 60}).text() == "servo:60,haptic:10,physics:1,devices:1");
+  CHECK(RecordSelection{}.thinned(6, {1, 6, 3}).text() == "servo:6,haptic:1,physics:2,devices:1");
+  CHECK(RecordSelection::parse("physics:4").thinned(6, {1, 6, 3}).text() == "physics:4");
+  CHECK(RecordSelection::parse("servo:4,haptic:3").thinned(6, {1, 6, 3}).text() == "servo:12,haptic:3");
+
+  const std::string full = tmp_path("decimate_record_full.h5");
+  const std::int64_t ticks = 60;
+  {
+    TraceWriter writer(full);
+    writer.set_attribute("rate_servo", std::int64_t{1200});
+    writer.set_attribute("rate_haptic", std::int64_t{300});   // d = 4
+    writer.set_attribute("rate_physics", std::int64_t{400});  // d = 3
+    TraceTable& servo = writer.table("servo");
+    TraceTable& haptic = writer.table("haptic");
+    TraceTable& physics = writer.table("physics");
+    for (TraceTable* t : {&servo, &haptic, &physics}) t->add_column("tick", 1, DType::kInt64, "tick");
+    for (std::int64_t tick = 0; tick < ticks; ++tick) {
+      servo.append_row()[0] = static_cast<double>(tick);
+      if (tick % 4 == 0) haptic.append_row()[0] = static_cast<double>(tick);
+      if (tick % 3 == 0) physics.append_row()[0] = static_cast<double>(tick);
+    }
+    writer.close("complete");
+  }
+  const std::string small = tmp_path("decimate_record_small.h5");
+  DecimateOptions options;
+  options.stride = 10;
+  decimate_trace(full, small, options);
+  const RecordSelection held = RecordSelection::from_attribute(read_string_attribute(small, "/", "record"));
+  // servo every 10th, haptic every lcm(1, 10 / 2) = 5th, physics every 10 / 1 = 10th.
+  CHECK(held.text() == "servo:10,haptic:5,physics:10,devices:1");
+  const std::array<std::int64_t, 3> period{1, 4, 3};
+  const char* tables[] = {"/servo/tick", "/haptic/tick", "/physics/tick"};
+  for (std::size_t l = 0; l < 3; ++l) {
+    INFO(tables[l]);
+    const std::int64_t step = held.every[l] * period[l];   // servo ticks between kept rows
+    std::vector<double> expected;
+    for (std::int64_t t = 0; t < ticks; t += step) expected.push_back(static_cast<double>(t));
+    CHECK(read_dataset(small, tables[l]).values == expected);
+  }
 }

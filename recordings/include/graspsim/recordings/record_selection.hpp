@@ -37,6 +37,12 @@ struct RecordSelection {
   // The root attribute `record` as read from a trace; nullopt (a trace written before the
   // attribute) means every loop at every tick.
   static RecordSelection from_attribute(const std::optional<std::string>& value);
+
+  // What is left when only the rows at servo ticks that are multiples of `stride` are kept (a
+  // golden's decimation), `period[l]` servo ticks being one tick of loop l: a loop kept every
+  // e-th of its ticks keeps every lcm(e, stride / gcd(stride, period))-th. /devices is copied
+  // whole, so it keeps its EVERY.
+  RecordSelection thinned(std::int64_t stride, const std::array<std::int64_t, 3>& period) const;
 };
 
 }  // namespace graspsim::recordings
