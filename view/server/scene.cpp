@@ -31,11 +31,16 @@ std::string root_string(const std::string& trace, const std::string& name, const
 }
 
 // A whole column, checked to hold `width` values per row.
-rec::Dataset column(const std::string& trace, const std::string& path, std::size_t width) {
+// Column `path`, `width` values a row, at least `rows` rows (a cut schema-2 trace's columns can
+// end apart; schema 3 keeps a table's columns in one row).
+rec::Dataset column(const std::string& trace, const std::string& path, std::size_t width, std::size_t rows = 0) {
   rec::Dataset d = rec::read_dataset(trace, path);
   const std::size_t w = d.shape.size() == 2 ? d.shape[1] : 1;
   if (w != width || d.shape.empty())
     throw ViewError(trace + ": " + path + ": expected " + std::to_string(width) + " values per row");
+  if (d.values.size() < width * rows)
+    throw ViewError(trace + ": " + path + " holds " + std::to_string(d.values.size() / width) + " rows, fewer than " +
+                    "its table's " + std::to_string(rows) + " ticks (a cut trace: `graspsim repair` evens its tables)");
   return d;
 }
 
@@ -101,8 +106,14 @@ void require_trace(const std::string& trace) {
   if (schema < 2 || schema > rec::kSchemaVersion)
     throw ViewError(trace + ": schema_version " + std::to_string(schema) + " is not one this graspsim reads (2 to " +
                     std::to_string(rec::kSchemaVersion) + ")");
-  for (const char* table : {"/physics", "/haptic", "/servo"})
-    if (!rec::has_object(trace, table)) throw ViewError(trace + ": not a graspsim trace (no table " + table + ")");
+  for (const char* table : {"/physics", "/haptic", "/servo"}) {
+    if (rec::has_object(trace, table)) continue;
+    if (rec::has_attribute(trace, "/", "record"))
+      throw ViewError(trace + ": recorded with --record '" + rec::read_string_attribute(trace, "/", "record") +
+                      "', without " + table + ": the viewer draws the bodies from /physics and the fingers from "
+                      "/haptic and /servo, and needs all three");
+    throw ViewError(trace + ": not a graspsim trace (no table " + table + ")");
+  }
 }
 
 void load_columns(ViewScene& s, const std::vector<std::string>& columns) {
@@ -123,23 +134,29 @@ void load_columns(ViewScene& s, const std::vector<std::string>& columns) {
     const std::string base = "/physics/objects/" + b.name + "/";
     if (std::find(columns.begin(), columns.end(), base + "position") == columns.end())
       throw ViewError(t + ": no column " + base + "position for body '" + b.name + "'");
-    const rec::Dataset p = column(t, base + "position", 3), q = column(t, base + "quaternion", 4);
+    const rec::Dataset p = column(t, base + "position", 3, np), q = column(t, base + "quaternion", 4, np);
     b.position.assign(p.values.begin(), p.values.begin() + 3 * np);
     b.quaternion.assign(q.values.begin(), q.values.begin() + 4 * np);
   }
-  // Row of /servo at each kept haptic tick (servo rows are every tick from its first).
+  // Row of /servo at each kept haptic tick (every servo tick, unless --record thinned them).
   std::vector<std::size_t> servo_row(nh);
   for (std::size_t i = 0; i < nh; ++i) {
     const auto it = std::lower_bound(servo.begin(), servo.end(), s.haptic_tick[i]);
     if (it == servo.end() || *it != s.haptic_tick[i])
-      throw ViewError(t + ": /servo has no row at haptic tick " + std::to_string(s.haptic_tick[i]));
+      throw ViewError(t + ": /servo has no row at haptic tick " + std::to_string(s.haptic_tick[i]) +
+                      (rec::has_attribute(t, "/", "record")
+                           ? " (recorded with --record '" + rec::read_string_attribute(t, "/", "record") + "')"
+                           : std::string()) +
+                      ": the viewer draws each finger's HIP from the /servo row at every haptic tick");
     servo_row[i] = static_cast<std::size_t>(it - servo.begin());
   }
   for (FingerView& f : s.fingers) {
     const std::string h = "/haptic/fingers/" + f.name + "/";
-    const rec::Dataset go = column(t, h + "god_object", 3), force = column(t, h + "force", 3),
-                       state = column(t, h + "state", 1), hip = column(t, "/servo/fingers/" + f.name + "/hip", 3),
-                       surface = column(t, h + "surface_point", 3), circle = column(t, h + "friction_radius", 1);
+    const std::size_t servo_rows = nh == 0 ? 0 : servo_row[nh - 1] + 1;
+    const rec::Dataset go = column(t, h + "god_object", 3, nh), force = column(t, h + "force", 3, nh),
+                       state = column(t, h + "state", 1, nh),
+                       hip = column(t, "/servo/fingers/" + f.name + "/hip", 3, servo_rows),
+                       surface = column(t, h + "surface_point", 3, nh), circle = column(t, h + "friction_radius", 1, nh);
     f.surface_point.assign(surface.values.begin(), surface.values.begin() + 3 * nh);
     f.friction_radius.assign(circle.values.begin(), circle.values.begin() + nh);
     f.god_object.assign(go.values.begin(), go.values.begin() + 3 * nh);

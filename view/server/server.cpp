@@ -48,6 +48,14 @@ ViewServer::ViewServer(Packed packed, std::string web, int port) : impl_(std::ma
   // is one it leaves alone.
   http.set_file_extension_and_mimetype_mapping("js", "application/x-javascript");
   http.set_mount_point("/", web);
+  // httplib's default socket sets SO_REUSEPORT, which lets a second listener bind a port one
+  // already holds (another graspsim view) and the kernel then shares the connections between
+  // them: a page could load one trace's scene and another's columns. SO_REUSEADDR alone still
+  // rebinds a port a closed server left in TIME_WAIT, and refuses one that is listened on.
+  http.set_socket_options([](socket_t sock) {
+    int yes = 1;
+    setsockopt(sock, SOL_SOCKET, SO_REUSEADDR, &yes, sizeof yes);
+  });
   if (port == 0) {
     port_ = http.bind_to_any_port("127.0.0.1");
     if (port_ <= 0) throw ViewError("cannot listen on 127.0.0.1: no free port");

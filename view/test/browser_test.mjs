@@ -46,8 +46,10 @@ try {
   process.exit(77);
 }
 
+// A command that should end by itself; one still running after 20 s (a view that serves where it
+// should refuse) is killed, and its status (null) fails the check.
 function run(args, cwd) {
-  const r = spawnSync(cli, args, { encoding: 'utf8', cwd });
+  const r = spawnSync(cli, args, { encoding: 'utf8', cwd, timeout: 20000, killSignal: 'SIGKILL' });
   return { status: r.status, out: r.stdout + r.stderr };
 }
 function dump(trace) {
@@ -276,11 +278,21 @@ async function checkBadInput() {
   writeFileSync(text, 'this is not an HDF5 file\n');
   expect2([text], /not_a_trace\.h5: not a graspsim trace/, 'a file that is not a trace');
   expect2([tmp], /not a regular file/, 'a directory');
+  // A trace recorded without the loops the viewer draws from says so, naming its --record.
+  const thin = join(tmp, 'physics_only.h5');
+  run(['run', join(src, 'scenarios/two_finger_lift.lua'), '--record', 'physics', '--out', thin], tmp);
+  expect2([thin], /recorded with --record 'physics:1', without \/haptic/, 'a trace recorded with --record physics');
   const holder = createServer();
   await new Promise((r) => holder.listen(0, '127.0.0.1', r));
   const port = holder.address().port;
   expect2([join(tmp, 'two_finger_lift.h5'), '--port', String(port)], new RegExp(`127\\.0\\.0\\.1:${port} \\(the port is in use`), `port ${port} in use`);
   holder.close();
+  // A port another graspsim view serves is in use too (not shared between the two).
+  const first = await serve(join(tmp, 'two_finger_lift.h5'), tmp);
+  const taken = Number(first.url.match(/:(\d+)\//)[1]);
+  expect2([join(tmp, 'two_finger_lift.h5'), '--port', String(taken)], new RegExp(`127\\.0\\.0\\.1:${taken} \\(the port is in use`),
+          `port ${taken} served by another graspsim view`);
+  await stop(first.child);
   expect2([], /needs a trace file/, 'no trace');
   const help = run(['view', '--help']);
   check(help.status === 0 && help.out.includes('--port N') && help.out.includes('exit status'), '--help documents the command');
