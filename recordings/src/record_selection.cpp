@@ -16,12 +16,15 @@ std::string known_loops() {
   return out;
 }
 
-// EVERY: decimal digits only, >= 1, at most 18 digits (an int64 without overflow).
+// EVERY: decimal digits only, 1 to kMaxEvery: a row every 10^9 ticks is one every 3.9 days of
+// servo ticks at 3 kHz, and the bound keeps every product with a loop's period (at most the
+// servo rate) or a golden's stride inside int64.
+constexpr std::int64_t kMaxEvery = 1000000000;
 bool parse_every(std::string_view text, std::int64_t& out) {
-  if (text.empty() || text.size() > 18 || text.find_first_not_of("0123456789") != std::string_view::npos) return false;
+  if (text.empty() || text.size() > 10 || text.find_first_not_of("0123456789") != std::string_view::npos) return false;
   out = 0;
   for (const char c : text) out = out * 10 + (c - '0');
-  return out >= 1;
+  return out >= 1 && out <= kMaxEvery;
 }
 
 }  // namespace
@@ -56,7 +59,7 @@ RecordSelection RecordSelection::parse(std::string_view spec) {
     if (s.every[k] != 0) throw std::invalid_argument("names loop '" + std::string(name) + "' twice");
     std::int64_t every = 1;
     if (colon != std::string_view::npos && !parse_every(item.substr(colon + 1), every))
-      throw std::invalid_argument("item '" + std::string(item) + "': EVERY must be a whole number >= 1");
+      throw std::invalid_argument("item '" + std::string(item) + "': EVERY must be a whole number from 1 to " + std::to_string(kMaxEvery));
     s.every[k] = every;
     start = comma + 1;
   }

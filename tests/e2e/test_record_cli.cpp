@@ -185,8 +185,11 @@ TEST_CASE("bad recording choices are refused with the flag named, exit 2, nothin
   };
   const std::vector<Case> cases = {
       {"--record foo", "--record foo: names an unknown loop 'foo'"},
-      {"--record physics:0", "EVERY must be a whole number >= 1"},
-      {"--record physics:-3", "EVERY must be a whole number >= 1"},
+      {"--record physics:0", "EVERY must be a whole number from 1 to 1000000000"},
+      {"--record physics:-3", "EVERY must be a whole number from 1 to 1000000000"},
+      {"--record physics:1000000001", "EVERY must be a whole number from 1 to 1000000000"},
+      {"--record physics:999999999999999999", "EVERY must be a whole number from 1 to 1000000000"},
+      {"--record physics --record servo", "--record given twice"},
       {"--record physics,physics:2", "names loop 'physics' twice"},
       {"--record physics,", "--record physics,: has an empty item"},
       {"--record", "--record needs LOOP[:EVERY]"},

@@ -265,6 +265,7 @@ int run_command(const std::vector<std::string>& args) {
     } else if (a == "--no-trace") {
       no_trace = true;
     } else if (a == "--record") {
+      if (record) return bad_input("--record given twice: name every loop in one, e.g. --record physics,servo:10");
       const std::string* v = value();
       if (!v || v->empty() || v->front() == '-')
         return bad_input("--record needs LOOP[:EVERY],... (loops: servo, haptic, physics, devices)" +

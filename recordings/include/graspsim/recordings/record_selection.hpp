@@ -30,9 +30,9 @@ struct RecordSelection {
   std::string text() const;
 
   // A --record argument: LOOP[:EVERY] items separated by commas, LOOP one of
-  // kRecordedLoopNames, EVERY a whole number >= 1 (default 1); loops not named are not
+  // kRecordedLoopNames, EVERY a whole number from 1 to 10^9 (default 1); loops not named are not
   // recorded. Throws std::invalid_argument naming the item that is wrong (an unknown loop, an
-  // EVERY that is not a whole number >= 1, a loop named twice, an empty item).
+  // EVERY that is not a whole number from 1 to 10^9, a loop named twice, an empty item).
   static RecordSelection parse(std::string_view spec);
   // The root attribute `record` as read from a trace; nullopt (a trace written before the
   // attribute) means every loop at every tick.
