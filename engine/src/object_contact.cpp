@@ -127,6 +127,36 @@ void roll_on(BodyState& bs, const FloorPoint& p, double floor_z, VertexContact& 
   vc.material = bs.rotation.transpose() * p.r;
 }
 
+// A body's floor vertices screened by height alone (box, hull, mesh; other shapes are never
+// screened): a vertex higher above the floor than `reach`, its height from one row of R, is one
+// the full test (track_floor_point) would find out of reach, and inactive. Meshes and hulls have
+// thousands of vertices, most far above the floor; a box has four upper corners. 1e-12 m per
+// metre of the numbers involved is added to `reach`, more than the few ulps by which that height
+// can differ from the full product's.
+class VertexScreen {
+ public:
+  VertexScreen(const Shape& shape, const BodyState& bs, double floor_z, double reach, double radius)
+      : row_z_(bs.rotation.row(2).transpose()), centre_z_(bs.position.z()), floor_z_(floor_z),
+        reach_(reach + 1e-12 * (1.0 + std::abs(bs.position.z()) + std::abs(floor_z) + radius)),
+        half_(shape.half_extents), box_(shape.kind == ShapeKind::kBox) {
+    if (shape.kind == ShapeKind::kMesh && shape.mesh) vertices_ = &shape.mesh->vertices;
+    if (shape.kind == ShapeKind::kConvex)
+      vertices_ = shape.hull ? &shape.hull->vertices : (shape.mesh ? &shape.mesh->vertices : nullptr);
+  }
+  bool out_of_reach(int k) const {
+    if (!vertices_ && !box_) return false;
+    const Vec3 local = vertices_ ? (*vertices_)[k] : box_vertex(half_, k);
+    return centre_z_ + row_z_.dot(local) - floor_z_ > reach_;
+  }
+
+ private:
+  Vec3 row_z_;
+  double centre_z_, floor_z_, reach_;   // m
+  Vec3 half_;                           // m: a box's half sizes
+  bool box_;
+  const std::vector<Vec3>* vertices_ = nullptr;
+};
+
 }  // namespace
 
 int floor_contact(const Model& model, int body, BodyState& bs, Wrench& out) {
@@ -136,20 +166,11 @@ int floor_contact(const Model& model, int body, BodyState& bs, Wrench& out) {
   const double floor_z = model.floor.height;
   int touching = 0;
   const int count = static_cast<int>(bs.floor_contacts.size());
-  // Meshes and hulls (thousands of vertices, most far above the floor): each vertex's height is
-  // screened first with one row of R, and one clearly above the floor (by 1e-12 m per metre of
-  // the numbers involved, far more than the few ulps by which the full product can differ) is
-  // what the full test would make it, inactive. The points that may touch take the full path.
-  const std::vector<Vec3>* vertices = nullptr;
-  if (bp.shape.kind == ShapeKind::kMesh && bp.shape.mesh) vertices = &bp.shape.mesh->vertices;
-  if (bp.shape.kind == ShapeKind::kConvex) {
-    vertices = bp.shape.hull ? &bp.shape.hull->vertices : (bp.shape.mesh ? &bp.shape.mesh->vertices : nullptr);
-  }
-  const Vec3 row_z = bs.rotation.row(2).transpose();
-  const double clear = 1e-12 * (1.0 + std::abs(bs.position.z()) + std::abs(floor_z));   // m
+  // A point is in contact only while under the floor (reach 0).
+  const VertexScreen screen(bp.shape, bs, floor_z, 0.0, 0.0);
   for (int k = 0; k < count; ++k) {
     VertexContact& vc = bs.floor_contacts[k];
-    if (vertices && bs.position.z() + row_z.dot((*vertices)[k]) > floor_z + clear) {
+    if (screen.out_of_reach(k)) {
       vc.active = false;
       continue;
     }
@@ -174,27 +195,15 @@ int floor_couplings(const Model& model, int body, const ContactPair& pair, BodyS
   const double reach = h * h * model.gravity.norm();   // m: how far gravity alone carries a point in a step
   int appended = 0;
   const int count = static_cast<int>(bs.floor_contacts.size());
-  // A vertex (box, hull, mesh) higher above the floor than any point of the body can close in
-  // the step, h (max(0, -v_z) + |w| radius) + reach, is inactive without the full test, whose own
-  // bound, from the vertex's velocity, is never larger. Its height comes from one row of R; the
-  // margin, 1e-12 m per metre of the numbers involved, covers the few ulps by which that differs
-  // from the full product.
-  const std::vector<Vec3>* vertices = nullptr;
-  if (bp.shape.kind == ShapeKind::kMesh && bp.shape.mesh) vertices = &bp.shape.mesh->vertices;
-  if (bp.shape.kind == ShapeKind::kConvex) {
-    vertices = bp.shape.hull ? &bp.shape.hull->vertices : (bp.shape.mesh ? &bp.shape.mesh->vertices : nullptr);
-  }
-  const bool screened = vertices || bp.shape.kind == ShapeKind::kBox;
-  const Vec3 row_z = bs.rotation.row(2).transpose();
-  const double screen = h * (std::max(0.0, -bs.velocity.z()) + bs.angular_velocity.norm() * radius) + reach +
-                        1e-12 * (1.0 + std::abs(bs.position.z()) + std::abs(floor_z) + radius);   // m
+  // A point counts while the step can close its height: no point of the body closes more than
+  // h (max(0, -v_z) + |w| radius) + reach, the bound the full test takes from its own velocity.
+  const VertexScreen screen(bp.shape, bs, floor_z,
+                            h * (std::max(0.0, -bs.velocity.z()) + bs.angular_velocity.norm() * radius) + reach,
+                            radius);
   for (int k = 0; k < count; ++k) {
-    if (screened) {
-      const Vec3 local = vertices ? (*vertices)[k] : box_vertex(bp.shape.half_extents, k);
-      if (bs.position.z() + row_z.dot(local) - floor_z > screen) {
-        bs.floor_contacts[k].active = false;
-        continue;
-      }
+    if (screen.out_of_reach(k)) {
+      bs.floor_contacts[k].active = false;
+      continue;
     }
     FloorPoint p;
     if (!track_floor_point(bp, bs, pair, floor_z, k, h, reach, p)) continue;
