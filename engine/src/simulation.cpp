@@ -71,20 +71,6 @@ Simulation::Simulation(Model model)
   finger_force_.resize(model_.fingers.size());
 }
 
-void Simulation::step(const Input& input, TickRecord& record) {
-  const std::int64_t n = state_.tick;
-  record.tick = n;
-  record.haptic_ran = to_haptic_ == 0;     // tick % (servo / haptic) == 0
-  record.physics_ran = to_physics_ == 0;   // tick % (servo / physics) == 0
-  record.diverged_body = -1;
-  if (record.haptic_ran) haptic_stage(input, record);   // 2: the friction cone, finger by finger
-  servo_stage(input, record);                           // 3: finger forces, reactions into the window
-  if (record.physics_ran) physics_stage(input, record); // 4: move the bodies
-  ++state_.tick;                                        // 5
-  to_haptic_ = (record.haptic_ran ? divisors_.haptic : to_haptic_) - 1;
-  to_physics_ = (record.physics_ran ? divisors_.physics : to_physics_) - 1;
-}
-
 void Simulation::haptic_stage(const Input& input, TickRecord& record) {
   // The finger broadphase is only asked by free fingers (a finger in contact tracks its own
   // body's surface): it follows the bodies here, when one will ask, not at every physics step.

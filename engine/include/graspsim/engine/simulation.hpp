@@ -39,7 +39,26 @@ class Simulation {
   //              then per body: clear the window; flag a body whose state diverged (record.hpp)
   //   5 tick += 1
   // Time is tick / servo, computed, never accumulated.
-  void step(const Input& input, TickRecord& record);
+  // Inline: at 50 Hz, 59 of 60 ticks run no loop but the servo's, and in a scene without fingers
+  // they run nothing at all; the call was a third of such a tick.
+  void step(const Input& input, TickRecord& record) {
+    // The loops that run this tick, in locals: the stages write through `record`, so its fields
+    // would be read back after every call.
+    const bool haptic = to_haptic_ == 0;     // tick % (servo / haptic) == 0
+    const bool physics = to_physics_ == 0;   // tick % (servo / physics) == 0
+    record.tick = state_.tick;
+    record.haptic_ran = haptic;
+    record.physics_ran = physics;
+    record.diverged_body = -1;
+    if (!model_.fingers.empty()) {                  // the haptic and servo loops serve fingers only
+      if (haptic) haptic_stage(input, record);      // 2: the friction cone, finger by finger
+      servo_stage(input, record);                   // 3: finger forces, reactions into the window
+    }
+    if (physics) physics_stage(input, record);      // 4: move the bodies
+    ++state_.tick;                                             // 5
+    to_haptic_ = (haptic ? divisors_.haptic : to_haptic_) - 1;
+    to_physics_ = (physics ? divisors_.physics : to_physics_) - 1;
+  }
 
   const Model& model() const { return model_; }
   const State& state() const { return state_; }
