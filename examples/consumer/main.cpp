@@ -7,12 +7,19 @@
 #include <string>
 
 #include <graspsim/app/run.hpp>
+#include <graspsim/engine/build_config.hpp>
 #include <graspsim/recordings/trace_writer.hpp>
 #include <graspsim/scripting/scenario.hpp>
 
 int main(int argc, char** argv) {
   if (argc != 3) {
     std::fprintf(stderr, "usage: %s SCENARIO.lua OUT.h5\n", argv[0]);
+    return 2;
+  }
+  // This file is compiled as the libraries were (the definitions and flags graspsim::app passes
+  // on), or the engine's headers would mean other layouts and other arithmetic here.
+  if (const std::string why = graspsim::build_config_mismatch(); !why.empty()) {
+    std::fprintf(stderr, "graspsim_consumer: %s\n", why.c_str());
     return 2;
   }
   const std::string scenario_path = argv[1], out = argv[2];
