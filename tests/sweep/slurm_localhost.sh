@@ -1,0 +1,86 @@
+#!/usr/bin/env bash
+# A one-node Slurm cluster on localhost, from Debian's slurm-wlm and munge, for the sweep's
+# Slurm test: every file (munge key and socket, slurm.conf, spool, state, logs) lives in one
+# temporary folder, on ports free at the start, so nothing on the machine is touched and two of
+# them can run at once.
+#   slurm_localhost.sh start DIR   starts munged, slurmctld and slurmd in DIR (made if missing),
+#                                  waits until the node is idle; prints the SLURM_CONF to use;
+#                                  exit 77 (and why on stderr) where Slurm cannot start
+#   slurm_localhost.sh stop DIR    stops the three daemons it started in DIR
+set -uo pipefail
+cmd=${1:-}; dir=${2:-}
+[ -n "$cmd" ] && [ -n "$dir" ] || { echo "usage: $0 start|stop DIR" >&2; exit 2; }
+
+stop() {
+  local f
+  for f in slurmd slurmctld munged; do
+    [ -f "$dir/$f.pid" ] && kill "$(cat "$dir/$f.pid")" 2>/dev/null
+  done
+  for f in slurmd slurmctld munged; do   # each gone within 5 s, or killed
+    [ -f "$dir/$f.pid" ] || continue
+    local pid; pid=$(cat "$dir/$f.pid")
+    for _ in $(seq 50); do kill -0 "$pid" 2>/dev/null || break; sleep 0.1; done
+    kill -9 "$pid" 2>/dev/null
+    rm -f "$dir/$f.pid"
+  done
+  return 0
+}
+skip() { echo "slurm_localhost: Slurm cannot start here: $1" >&2; [ -f "$dir/$2" ] && tail -n 20 "$dir/$2" >&2; stop; exit 77; }
+
+if [ "$cmd" = stop ]; then stop; exit 0; fi
+[ "$cmd" = start ] || { echo "usage: $0 start|stop DIR" >&2; exit 2; }
+for p in munged slurmctld slurmd sbatch sinfo; do
+  command -v "$p" >/dev/null || [ -x "/usr/sbin/$p" ] || skip "no $p (Debian packages munge, slurm-wlm)" none
+done
+[ "$(id -u)" -eq 0 ] || skip "the daemons run as root here, and this is uid $(id -u)" none
+mkdir -p "$dir"/{spool,state,munge} && chmod 700 "$dir/munge"
+free_port() { python3 -c 'import socket; s=socket.socket(); s.bind(("127.0.0.1", 0)); print(s.getsockname()[1])'; }
+ctld_port=$(free_port); d_port=$(free_port)
+host=$(hostname -s)
+cpus=$(nproc)
+memory=$(awk '/MemTotal/ { print int($2 / 1024 / 2) }' /proc/meminfo)   # MB: half, so slurmd agrees
+
+# munge: its own key and socket (a credential made with this key is valid only here).
+dd if=/dev/urandom of="$dir/munge/munge.key" bs=1024 count=1 status=none && chmod 400 "$dir/munge/munge.key"
+/usr/sbin/munged --force --key-file="$dir/munge/munge.key" --socket="$dir/munge/socket" \
+  --pid-file="$dir/munged.pid" --log-file="$dir/munged.log" --seed-file="$dir/munge/seed" \
+  || skip "munged did not start" munged.log
+
+cat >"$dir/slurm.conf" <<CONF
+# A one-node cluster on localhost (tests/sweep/slurm_localhost.sh).
+ClusterName=graspsim-test
+SlurmctldHost=$host(127.0.0.1)
+SlurmctldPort=$ctld_port
+SlurmdPort=$d_port
+SlurmUser=root
+SlurmdUser=root
+AuthType=auth/munge
+AuthInfo=socket=$dir/munge/socket
+CredType=cred/munge
+StateSaveLocation=$dir/state
+SlurmdSpoolDir=$dir/spool
+SlurmctldPidFile=$dir/slurmctld.pid
+SlurmdPidFile=$dir/slurmd.pid
+SlurmctldLogFile=$dir/slurmctld.log
+SlurmdLogFile=$dir/slurmd.log
+ProctrackType=proctrack/linuxproc
+TaskPlugin=task/none
+JobAcctGatherType=jobacct_gather/none
+AccountingStorageType=accounting_storage/none
+SchedulerType=sched/backfill
+SelectType=select/cons_tres
+SelectTypeParameters=CR_CPU
+ReturnToService=2
+MpiDefault=none
+NodeName=$host NodeAddr=127.0.0.1 CPUs=$cpus RealMemory=$memory State=UNKNOWN
+PartitionName=test Nodes=$host Default=YES MaxTime=INFINITE State=UP
+CONF
+export SLURM_CONF="$dir/slurm.conf"
+/usr/sbin/slurmctld -f "$SLURM_CONF" || skip "slurmctld did not start" slurmctld.log
+/usr/sbin/slurmd -f "$SLURM_CONF" || skip "slurmd did not start" slurmd.log
+for _ in $(seq 100); do   # up to 20 s for the node to register
+  state=$(sinfo -h -N -o %t 2>/dev/null | head -n1)
+  [ "$state" = idle ] && { echo "$SLURM_CONF"; exit 0; }
+  sleep 0.2
+done
+skip "the node never became idle (sinfo: '${state:-nothing}')" slurmd.log
