@@ -91,6 +91,9 @@ def main():
         fd, partial = tempfile.mkstemp(suffix=".png", dir=folder)
         os.close(fd)
         fig.savefig(partial, dpi=100)
+        umask = os.umask(0)
+        os.umask(umask)
+        os.chmod(partial, 0o666 & ~umask)   # as an ordinary new file, not mkstemp's 0600
         os.replace(partial, args.out)
     except OSError as e:
         fail(f"{args.out}: cannot write: {e.strerror}")
