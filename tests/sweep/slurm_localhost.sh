@@ -11,16 +11,24 @@ set -uo pipefail
 cmd=${1:-}; dir=${2:-}
 [ -n "$cmd" ] && [ -n "$dir" ] || { echo "usage: $0 start|stop DIR" >&2; exit 2; }
 
+# The pid in DIR/NAME.pid if that process is still NAME (a pid file left by a run that was
+# killed outright may name another process by now).
+daemon_pid() {
+  local pid
+  pid=$(cat "$dir/$1.pid" 2>/dev/null) || return 1
+  tr '\0' ' ' <"/proc/$pid/cmdline" 2>/dev/null | grep -q "$1" && echo "$pid"
+}
+
 stop() {
-  local f
+  local f pid
   for f in slurmd slurmctld munged; do
-    [ -f "$dir/$f.pid" ] && kill "$(cat "$dir/$f.pid")" 2>/dev/null
+    pid=$(daemon_pid $f) && kill "$pid" 2>/dev/null
   done
   for f in slurmd slurmctld munged; do   # each gone within 5 s, or killed
-    [ -f "$dir/$f.pid" ] || continue
-    local pid; pid=$(cat "$dir/$f.pid")
-    for _ in $(seq 50); do kill -0 "$pid" 2>/dev/null || break; sleep 0.1; done
-    kill -9 "$pid" 2>/dev/null
+    if pid=$(daemon_pid $f); then
+      for _ in $(seq 50); do kill -0 "$pid" 2>/dev/null || break; sleep 0.1; done
+      kill -9 "$pid" 2>/dev/null
+    fi
     rm -f "$dir/$f.pid"
   done
   return 0

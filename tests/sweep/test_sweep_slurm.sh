@@ -9,9 +9,10 @@ set -u
 cli=$1 src=$2 tmp=$3/sweep_slurm
 source "$src/tests/sweep/sweep_common.sh"
 lift=$src/scenarios/two_finger_lift.lua
+cluster=$tmp/cluster
+"$src/tests/sweep/slurm_localhost.sh" stop "$cluster"   # one a killed test left running, if any
 rm -rf "$tmp" && mkdir -p "$tmp" || exit 1
 
-cluster=$tmp/cluster
 trap '"$src/tests/sweep/slurm_localhost.sh" stop "$cluster"' EXIT
 SLURM_CONF=$("$src/tests/sweep/slurm_localhost.sh" start "$cluster" 2>"$tmp/start.log")
 rc=$?

@@ -230,8 +230,8 @@ int sweep_command(const std::vector<std::string>& args) {
         return bad_input("--seeds needs a whole number from 1 to 1000000" + (v ? " (got '" + *v + "')" : std::string()));
     } else if (a == "--jitter") {
       char* end = nullptr;
-      if (!take() || (plan.jitter = std::strtod(v->c_str(), &end), *end != '\0' || v->empty()) ||
-          !(plan.jitter > 0.0) || !std::isfinite(plan.jitter))
+      if (take()) plan.jitter = std::strtod(v->c_str(), &end);
+      if (!v || v->empty() || *end != '\0' || !(plan.jitter > 0.0) || !std::isfinite(plan.jitter))
         return bad_input("--jitter needs an amplitude in m, a number > 0" + (v ? " (got '" + *v + "')" : std::string()));
       jitter_given = true;
     } else if (a == "--jobs") {
