@@ -396,6 +396,25 @@ int run_command(const std::vector<std::string>& args) {
     std::cerr << "graspsim: warning: " << w << "\n";
   };
 
+  // The summary may be none of the run's inputs, nor its trace (checked before anything runs).
+  if (!summary.empty()) {
+    std::vector<graspsim::app::InputFile> inputs = options.inputs;
+    inputs.push_back({scenario->path(), "the scenario"});
+    for (const std::string& f : scenario->files()) inputs.push_back({f, "a mesh file of the scenario"});
+    if (!no_trace) {
+      const std::string trace = out.empty() ? graspsim::app::default_trace_name(scenario->name()) : out;
+      inputs.push_back({trace, "the trace"});
+      inputs.push_back({graspsim::app::partial_name(trace), "the trace"});
+    }
+    for (const auto& input : inputs) {
+      std::error_code ec;
+      for (const std::string& written : {summary, summary + ".partial"})
+        if (written == input.path || std::filesystem::equivalent(written, input.path, ec))
+          return bad_input("--summary " + summary + " is " + input.what + " ('" + input.path +
+                           "'): it would be written over; choose another file");
+    }
+  }
+
   // A run that will not fit (memory for its trace buffers, disk for its trace) is refused
   // before anything is written (README.md "Run length and rates").
   std::string size_warning;
@@ -444,11 +463,16 @@ int run_command(const std::vector<std::string>& args) {
                  no_trace ? "" : "  (the trace keeps every tick up to there)\n");
   }
   const int failed = graspsim::cli::print_expectations(result, quiet);
-  if (!summary.empty()) {
-    std::FILE* f = std::fopen(summary.c_str(), "w");
+  if (!summary.empty()) {   // written whole (a .partial renamed), so a reader never sees half
+    const std::string partial = summary + ".partial";
     const std::string text = graspsim::app::sweep::summary_text(result.expectations);
-    if (!f || std::fwrite(text.data(), 1, text.size(), f) != text.size() || std::fclose(f) != 0)
+    std::FILE* f = std::fopen(partial.c_str(), "w");
+    bool written = f && std::fwrite(text.data(), 1, text.size(), f) == text.size();
+    if (f) written = std::fclose(f) == 0 && written;
+    if (!written || std::rename(partial.c_str(), summary.c_str()) != 0) {
+      std::remove(partial.c_str());
       std::fprintf(stderr, "graspsim: cannot write --summary %s\n", summary.c_str());
+    }
   }
   if (!result.trace_error.empty()) return kExitTraceFault;
   if (result.interrupted) return graspsim::cli::exit_interrupted(&g_signal);
