@@ -1,9 +1,10 @@
 #!/usr/bin/env bash
 # graspsim sweep --slurm on a one-node Slurm started here on localhost (slurm_localhost.sh,
 # Debian's slurm-wlm and munge, which tools/setup.sh installs): the 3 x 3 x 2 lift sweep as a
-# job array gives the table a local sweep gives, wall times aside; a --resume with every row
-# there submits nothing and writes the same table. Skipped (exit 77), saying why, only where
-# Slurm cannot start. The daemons are stopped however the test ends.
+# job array gives the table a local sweep gives, wall times aside; --resume submits only a run
+# without a row, and with every row there submits nothing; the table stays the same. Skipped
+# (exit 77), saying why, only where Slurm cannot start. The daemons are stopped however the
+# test ends.
 # Usage: test_sweep_slurm.sh GRASPSIM SOURCE_DIR TMP_DIR
 set -u
 cli=$1 src=$2 tmp=$3/sweep_slurm
@@ -31,6 +32,15 @@ diff <(table_without_wall "$tmp/local/sweep.csv") <(table_without_wall "$tmp/slu
 got=$(status_by_point "$tmp/slurm/sweep.csv" | sort)
 [ "$got" = "$sweep_expected" ] || fail "status by (mu, mass):"$'\n'"$got"
 echo "ok: the job array's table is the local one (18 rows)"
+
+# Resumable likewise: a run without a row is submitted alone, and the table is the same.
+rm "$tmp/slurm/runs/0005.row"
+"$cli" sweep "$lift" "${sweep_grid[@]}" --slurm --resume --out "$tmp/slurm" >"$tmp/missing.log" 2>&1 \
+  || { cat "$tmp/missing.log"; fail "--slurm --resume with run 5 missing exited $?"; }
+grep -q "submitted 1 runs as Slurm job array" "$tmp/missing.log" || { cat "$tmp/missing.log"; fail "--resume did not submit run 5 alone"; }
+diff <(table_without_wall "$tmp/local/sweep.csv") <(table_without_wall "$tmp/slurm/sweep.csv") \
+  || fail "the resumed --slurm table differs from the local one"
+echo "ok: --slurm --resume submits only the run without a row, same table"
 
 cp "$tmp/slurm/sweep.csv" "$tmp/first.csv"
 "$cli" sweep "$lift" "${sweep_grid[@]}" --slurm --resume --out "$tmp/slurm" >"$tmp/resume.log" 2>&1 \
