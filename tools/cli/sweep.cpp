@@ -1,6 +1,7 @@
 // `graspsim sweep`: the cross product of --set values (times jitter seeds), each one child
 // `graspsim run`, locally in parallel or as a Slurm job array; one summary table (README.md "Sweeps").
 #include "cli/sweep.hpp"
+#include "cli/sweep_slurm.hpp"
 
 #include <atomic>
 #include <cerrno>
@@ -94,12 +95,6 @@ std::string self_program() {
   return ec ? std::string("graspsim") : self.string();
 }
 
-std::string quote(const std::string& s) {   // for /bin/sh
-  std::string out = "'";
-  for (const char c : s) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return out + "'";
-}
-
 // Every axis value, and the fixed sets, as the runs will get them: the scenario's own --set
 // errors (an unknown field, a bad value) before anything runs. Each value is tried once, with the
 // other axes at their first value.
@@ -138,60 +133,13 @@ struct Progress {
   }
 };
 
-// Submits `pending` as one job array and waits until none of its tasks is pending or running.
-// Returns "" or what went wrong.
-std::string run_slurm(const Plan& plan, const std::string& dir, const std::vector<std::size_t>& pending,
-                      const Progress& progress) {
-  const fs::path slurm = fs::path(dir) / "slurm";
-  fs::create_directories(slurm);
-  const std::string script = (slurm / "job.sh").string();
-  {
-    std::ofstream out(script, std::ios::trunc);
-    out << "#!/bin/sh\n"
-        << "# One run of the graspsim sweep in " << dir << " per array task (graspsim sweep --slurm).\n"
-        << "#SBATCH --job-name=graspsim-sweep\n"
-        << "#SBATCH --ntasks=1\n"
-        << "#SBATCH --cpus-per-task=1\n"
-        << "#SBATCH --output=" << (slurm / "task-%a.out").string() << "\n"
-        << "exec " << quote(self_program()) << " sweep-task " << quote(dir) << " \"$SLURM_ARRAY_TASK_ID\"\n";
-    if (!out) return "cannot write " + script;
-  }
-  const std::string submit = "sbatch --parsable --array=" + array_list(pending) + " " + quote(script);
-  FILE* p = popen((submit + " 2>&1").c_str(), "r");
-  if (!p) return "cannot run sbatch";
-  std::string reply;
-  char buf[256];
-  while (std::fgets(buf, sizeof buf, p)) reply += buf;
-  const int status = pclose(p);
-  const std::string job = reply.substr(0, reply.find_first_of(";\n"));
-  if (status != 0 || job.empty() || job.find_first_not_of("0123456789") != std::string::npos)
-    return "sbatch refused the job array (" + submit + "): " + reply;
-  std::fprintf(stderr, "graspsim sweep: submitted %zu runs as Slurm job array %s (%s)\n", pending.size(), job.c_str(),
-               script.c_str());
-  std::size_t reported = 0;
-  for (;;) {
-    if (g_stop.load()) {
-      std::system(("scancel " + job).c_str());
-      return "stopped: cancelled job " + job;
-    }
-    FILE* q = popen(("squeue -h -j " + job + " -o %i 2>/dev/null").c_str(), "r");
-    std::string queued;
-    while (q && std::fgets(buf, sizeof buf, q)) queued += buf;
-    if (q) pclose(q);
-    std::size_t done = 0;
-    for (const std::size_t i : pending) done += read_row(plan, dir, i).has_value();
-    if (done != reported) progress(reported = done, pending.size());
-    if (queued.find_first_not_of(" \n") == std::string::npos) return {};
-    std::this_thread::sleep_for(std::chrono::milliseconds(500));
-  }
-}
-
 void plot(const std::string& dir) {
   const std::string script = GRASPSIM_PLOT_SWEEP;
   // Debian's python3 (python3-matplotlib, tools/setup.sh), not one earlier on PATH without it.
   const std::string python = fs::exists("/usr/bin/python3") ? "/usr/bin/python3" : "python3";
-  const std::string command = python + " " + quote(script) + " " + quote((fs::path(dir) / "sweep.csv").string()) +
-                              " --out " + quote((fs::path(dir) / "sweep.png").string());
+  const std::string command = python + " " + shell_quote(script) + " " +
+                              shell_quote((fs::path(dir) / "sweep.csv").string()) + " --out " +
+                              shell_quote((fs::path(dir) / "sweep.png").string());
   if (!fs::exists(script) || std::system(command.c_str()) != 0)
     std::cerr << "graspsim sweep: warning: no plot (" << command
               << " failed: it needs python3-matplotlib); the table is written\n";
@@ -293,7 +241,7 @@ int sweep_command(const std::vector<std::string>& args) {
   if (progress.kept > 0) std::fprintf(stderr, "graspsim sweep: %zu of %zu runs are done already\n", progress.kept, plan.size());
   if (!pending.empty()) {
     if (slurm) {
-      if (const std::string why = run_slurm(plan, dir, pending, progress); !why.empty()) {
+      if (const std::string why = run_slurm(self_program(), plan, dir, pending, progress, g_stop); !why.empty()) {
         std::cerr << "graspsim sweep: " << why << "\n";
         if (g_stop.load()) return 128 + g_stop_signal.load();
         return kExitFailed;
