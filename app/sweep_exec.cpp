@@ -8,6 +8,7 @@
 #include <fcntl.h>
 #include <filesystem>
 #include <map>
+#include <sstream>
 #include <spawn.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -50,13 +51,14 @@ Row finish_run(const Plan& plan, const std::string& dir, std::size_t index, int 
     const std::string trace = plan.run_file(dir, index, "h5");
     if (std::filesystem::exists(trace)) row.trace = std::filesystem::relative(trace, dir).string();
   }
-  if (row.exit_status >= 2) {   // the last line the run wrote (graspsim's own error message)
-    const std::string log = read_file(plan.run_file(dir, index, "log"));
-    std::size_t end = log.find_last_not_of('\n');
-    if (end != std::string::npos) {
-      const std::size_t start = log.rfind('\n', end);
-      row.error = log.substr(start == std::string::npos ? 0 : start + 1, end + 1 - (start == std::string::npos ? 0 : start + 1));
+  if (row.exit_status >= 2) {   // why: graspsim's own last error line, else the last line written
+    std::istringstream log(read_file(plan.run_file(dir, index, "log")));
+    std::string line, last;
+    while (std::getline(log, line)) {
+      if (line.rfind("graspsim: ", 0) == 0 && line.rfind("graspsim: warning: ", 0) != 0) row.error = line.substr(10);
+      if (!line.empty()) last = line;
     }
+    if (row.error.empty()) row.error = last;
   }
   if (row.exit_status < 128) write_row(plan, dir, row);
   return row;

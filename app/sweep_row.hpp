@@ -26,7 +26,7 @@ struct Row {
   int exit_status = 0;                 // of `graspsim run`: 0 pass, 1 fail, 2 bad input, 3 trace, 128 + signal
   double wall = 0.0;                   // s: the run's process, start to end
   std::string trace;                   // the trace's path relative to the sweep's folder; "" none
-  std::string error;                   // the run's last line on stderr, when it ended with exit >= 2
+  std::string error;                   // exit >= 2: graspsim's last error line (without "graspsim: ")
   std::vector<Expectation> expectations;   // in the scenario's order; empty if the run never got there
 };
 

@@ -3,7 +3,8 @@
 # or fails) with --jobs 2 and --jobs 1 gives the same table, wall times aside, since every run is
 # deterministic; the pass/fail table is the friction threshold's; the HDF5 table holds the CSV's
 # columns; --resume keeps finished rows and reruns only a missing one; --keep-traces keeps a trace
-# per run; bad input exits 2 naming the flag and leaves an existing sweep as it was.
+# per run; a run in error is reported with its message; bad input exits 2 naming the flag and
+# leaves an existing sweep as it was.
 # Usage: test_sweep_local.sh GRASPSIM SOURCE_DIR TMP_DIR
 set -u
 cli=$1 src=$2 tmp=$3/sweep_local
@@ -57,6 +58,16 @@ echo "ok: --resume reran 1 run of 18, same table"
 grep -q "^1,1.2,pass,0,[^,]*,runs/0001.h5," "$tmp/traces/sweep.csv" && [ -s "$tmp/traces/runs/0001.h5" ] \
   || { cat "$tmp/traces/sweep.csv"; fail "--keep-traces: no trace runs/0001.h5 in the table"; }
 echo "ok: --keep-traces"
+
+# A run that ends in an error: its row says so and why, and the sweep exits 1. The finger's
+# script of error_midway.lua raises an error at t = 0.5 s, so a 0.2 s run passes, a 1 s run not.
+"$cli" sweep "$src/tests/e2e/data/error_midway.lua" --grid duration=0.2,1 --out "$tmp/error" >"$tmp/error.log" 2>&1
+rc=$?
+[ $rc -eq 1 ] || { cat "$tmp/error.log"; fail "a sweep with a run in error exited $rc, expected 1"; }
+grep -q '^0,0.2,pass,0,' "$tmp/error/sweep.csv" &&
+  grep -q '^1,1,error,2,[^,]*,the run stopped early: .*the hand slipped off the script' "$tmp/error/sweep.csv" \
+  || { cat "$tmp/error/sweep.csv"; fail "the run in error is not reported with its message"; }
+echo "ok: a run in error: status error, exit 2, its message; the sweep exits 1"
 
 # Bad input: exit 2, the flag or field named, an existing sweep untouched.
 before=$(cd "$tmp/j1" && ls -l --time-style=+%s.%N . runs | md5sum)
