@@ -24,6 +24,8 @@ graspsim_packages=(
                                     # "Sanitizers and fuzzing")
   libcpp-httplib-dev                # `graspsim view`'s HTTP server (view/README.md)
   chromium                          # the browser test of `graspsim view` (view/test), headless
+  slurm-wlm munge                   # `graspsim sweep --slurm`'s test starts a one-node Slurm on
+                                    # localhost (tests/sweep/slurm_localhost.sh)
 )
 # The page's packages come from the npm registry (view/web/package-lock.json): Node and npm,
 # from Debian unless the machine already has them (a Node of its own carries its own npm,

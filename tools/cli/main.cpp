@@ -17,8 +17,10 @@
 #include "app/pacer.hpp"
 #include "app/run.hpp"
 #include "app/run_budget.hpp"
+#include "app/sweep_row.hpp"
 #include "cli/repair.hpp"
 #include "cli/replay.hpp"
+#include "cli/sweep.hpp"
 #include "cli/view.hpp"
 #include "cli/report.hpp"
 #include "graspsim_version.hpp"
@@ -38,7 +40,9 @@ using graspsim::cli::kExitTraceFault;
 constexpr const char* kUsage =
     "usage: graspsim run SCENARIO.lua [--out FILE.h5] [--duration S] [--set NAME=VALUE]...\n"
     "                [--device FINGER=SPEC]... [--jitter A [--jitter-seed N]] [--refuse-unstable]\n"
-    "                [--no-trace | --record LOOP[:EVERY],...]\n"
+    "                [--no-trace | --record LOOP[:EVERY],...] [--summary FILE]\n"
+    "       graspsim sweep SCENARIO.lua --grid NAME=V1,V2,... [--grid ...] [--seeds N] [--jobs N]\n"
+    "                --out DIR [--keep-traces] [--slurm] [--resume]\n"
     "       graspsim replay TRACE.h5 [--out NEW.h5] [--set NAME=VALUE]...\n"
     "       graspsim repair TRACE.h5\n"
     "       graspsim view TRACE.h5 [--port N] [--open]\n"
@@ -90,6 +94,9 @@ constexpr const char* kHelp =
     "                       finds (as the scenario field stability = \"refuse\"), exit 2;\n"
     "                       without it each one is a warning on stderr, with its time\n"
     "  --quiet              print only errors and failed expectations\n"
+    "  --summary FILE       also write each expectation checked as a line of FILE,\n"
+    "                       PASS|FAIL<tab>what<tab>measured (tab, newline, backslash as \\t \\n \\\\;\n"
+    "                       what `graspsim sweep` reads)\n"
     "  -h, --help           this help\n"
     "  --version            the build's version\n"
     "\n"
@@ -113,6 +120,12 @@ constexpr const char* kHelp =
     "its last flush but one (less than 0.25 s of simulated time lost): h5py opens it with\n"
     "swmr=True; after `graspsim repair FILE.h5.partial` (see `graspsim repair --help`) every\n"
     "HDF5 tool does.\n"
+    "\n"
+    "usage: graspsim sweep SCENARIO.lua --grid NAME=V1,V2,... --out DIR [options]\n"
+    "       (graspsim sweep --help for more)\n"
+    "\n"
+    "Runs a scenario over the cross product of --set values (and jitter seeds), locally in\n"
+    "parallel or as a Slurm job array, into one summary table (CSV, HDF5) and a plot.\n"
     "\n"
     "usage: graspsim replay TRACE.h5 [options]   (graspsim replay --help for more)\n"
     "\n"
@@ -241,6 +254,7 @@ int run_command(const std::vector<std::string>& args) {
   bool quiet = false, refuse_unstable = false, no_trace = false, out_given = false, compress_given = false;
   std::optional<graspsim::recordings::RecordSelection> record;
   std::vector<std::string> device_options;
+  std::string summary;   // --summary FILE: the expectations, one line each
   bool jitter_seed_given = false;
   for (std::size_t i = 0; i < args.size(); ++i) {
     const std::string& a = args[i];
@@ -304,6 +318,11 @@ int run_command(const std::vector<std::string>& args) {
       compress_given = true;
     } else if (a == "--quiet") {
       quiet = true;
+    } else if (a == "--summary") {
+      const std::string* v = value();
+      if (!v || v->empty() || v->front() == '-')
+        return bad_input("--summary needs a file name" + (v ? " (got '" + *v + "')" : std::string()));
+      summary = *v;
     } else if (a == "--refuse-unstable") {
       refuse_unstable = true;
     } else if (a.rfind("-", 0) == 0) {
@@ -377,6 +396,25 @@ int run_command(const std::vector<std::string>& args) {
     std::cerr << "graspsim: warning: " << w << "\n";
   };
 
+  // The summary may be none of the run's inputs, nor its trace (checked before anything runs).
+  if (!summary.empty()) {
+    std::vector<graspsim::app::InputFile> inputs = options.inputs;
+    inputs.push_back({scenario->path(), "the scenario"});
+    for (const std::string& f : scenario->files()) inputs.push_back({f, "a mesh file of the scenario"});
+    if (!no_trace) {
+      const std::string trace = out.empty() ? graspsim::app::default_trace_name(scenario->name()) : out;
+      inputs.push_back({trace, "the trace"});
+      inputs.push_back({graspsim::app::partial_name(trace), "the trace"});
+    }
+    for (const auto& input : inputs) {
+      std::error_code ec;
+      for (const std::string& written : {summary, summary + ".partial"})
+        if (written == input.path || std::filesystem::equivalent(written, input.path, ec))
+          return bad_input("--summary " + summary + " is " + input.what + " ('" + input.path +
+                           "'): it would be written over; choose another file");
+    }
+  }
+
   // A run that will not fit (memory for its trace buffers, disk for its trace) is refused
   // before anything is written (README.md "Run length and rates").
   std::string size_warning;
@@ -425,6 +463,17 @@ int run_command(const std::vector<std::string>& args) {
                  no_trace ? "" : "  (the trace keeps every tick up to there)\n");
   }
   const int failed = graspsim::cli::print_expectations(result, quiet);
+  if (!summary.empty()) {   // written whole (a .partial renamed), so a reader never sees half
+    const std::string partial = summary + ".partial";
+    const std::string text = graspsim::app::sweep::summary_text(result.expectations);
+    std::FILE* f = std::fopen(partial.c_str(), "w");
+    bool written = f && std::fwrite(text.data(), 1, text.size(), f) == text.size();
+    if (f) written = std::fclose(f) == 0 && written;
+    if (!written || std::rename(partial.c_str(), summary.c_str()) != 0) {
+      std::remove(partial.c_str());
+      std::fprintf(stderr, "graspsim: cannot write --summary %s\n", summary.c_str());
+    }
+  }
   if (!result.trace_error.empty()) return kExitTraceFault;
   if (result.interrupted) return graspsim::cli::exit_interrupted(&g_signal);
   if (!result.error.empty()) return kExitBadInput;
@@ -547,6 +596,8 @@ int main(int argc, char** argv) {
     handle_stop_signals();
     return graspsim::cli::replay_command({args.begin() + 1, args.end()}, &g_interrupt, &g_signal);
   }
+  if (command == "sweep") return graspsim::cli::sweep_command({args.begin() + 1, args.end()});
+  if (command == "sweep-task") return graspsim::cli::sweep_task_command({args.begin() + 1, args.end()});
   if (command == "repair") return graspsim::cli::repair_command({args.begin() + 1, args.end()});
   if (command == "compare") return compare_command({args.begin() + 1, args.end()});
   if (command == "view") return graspsim::cli::view_command({args.begin() + 1, args.end()});

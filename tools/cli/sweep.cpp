@@ -1,0 +1,311 @@
+// `graspsim sweep`: the cross product of --set values (times jitter seeds), each one child
+// `graspsim run`, locally in parallel or as a Slurm job array; one summary table (README.md "Sweeps").
+#include "cli/sweep.hpp"
+#include "cli/sweep_slurm.hpp"
+
+#include <atomic>
+#include <cerrno>
+#include <chrono>
+#include <cmath>
+#include <csignal>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <sys/wait.h>
+#include <thread>
+#include <unistd.h>
+
+#include "app/sweep_exec.hpp"
+#include "app/sweep_table.hpp"
+#include "cli/report.hpp"
+#include "graspsim/recordings/trace_writer.hpp"
+#include "graspsim/scripting/scenario.hpp"
+
+namespace graspsim::cli {
+namespace {
+
+namespace fs = std::filesystem;
+using namespace app::sweep;
+
+constexpr const char* kSweepHelp =
+    "usage: graspsim sweep SCENARIO.lua --grid NAME=V1,V2,... [--grid ...] [--set NAME=VALUE]...\n"
+    "                [--seeds N [--jitter A]] [--jobs N] --out DIR [--keep-traces] [--slurm] [--resume]\n"
+    "\n"
+    "Runs SCENARIO once for every combination of the --grid values (each given to the run as\n"
+    "--set NAME=V), and with --seeds N once more for each seed 0 .. N-1 of jittered waypoints\n"
+    "(--jitter A --jitter-seed S; A in m, default 0.5e-3). Each run is its own `graspsim run`\n"
+    "process. Writes DIR/sweep.csv and DIR/sweep.h5 (one row per run: the grid values, the seed,\n"
+    "status, exit status, wall time, every expectation's pass (1/0, -1 not checked) and measured\n"
+    "text) and DIR/sweep.png (pass/fail over the first two grid axes); each run's output is in\n"
+    "DIR/runs/. The runs are deterministic: the table, wall_s aside, is the same for any --jobs\n"
+    "and on Slurm.\n"
+    "\n"
+    "options:\n"
+    "  --grid NAME=V1,V2,...  a scenario field or param() and its values (repeatable; the first\n"
+    "                       axis changes slowest); NAME=V1;V2 when a value holds commas\n"
+    "  --set NAME=VALUE     an override for every run\n"
+    "  --seeds N            N jitter seeds per grid point (1 .. 1000000)\n"
+    "  --jitter A           the seeds' jitter amplitude in m (default 0.5e-3)\n"
+    "  --jobs N             runs at once (default: the number of processors)\n"
+    "  --out DIR            the sweep's folder (made if missing; one holding another sweep is\n"
+    "                       refused, and one holding this sweep needs --resume)\n"
+    "  --keep-traces        each run writes DIR/runs/<run>.h5 (default: --no-trace)\n"
+    "  --resume             keep the rows of finished runs in DIR and run only the others\n"
+    "  --slurm              submit the runs as a Slurm job array (sbatch --array; sbatch's own\n"
+    "                       SBATCH_* variables choose partition, account, time), wait for it to\n"
+    "                       end, then write the same table; with --resume only the missing runs\n"
+    "                       are submitted (none missing: the table is written at once)\n"
+    "\n"
+    "exit status: 0 every run ended and is in the table (whatever its expectations), 1 some run\n"
+    "ended in an error (exit 2 or 3; the table's `error` says why) or left no row, 2 bad input\n"
+    "(arguments, an unknown or bad --grid or --set field, an --out that cannot be written), 128 +\n"
+    "the signal when stopped (the finished rows are kept: --resume goes on).\n";
+
+std::atomic<bool> g_stop{false};
+std::atomic<int> g_stop_signal{0};
+extern "C" void on_sweep_signal(int s) {
+  g_stop_signal.store(s);
+  g_stop.store(true);
+}
+
+// Without SA_RESTART, so that waiting for a run returns when a signal comes.
+void handle_signals() {
+  struct sigaction action {};
+  action.sa_handler = on_sweep_signal;
+  sigemptyset(&action.sa_mask);
+  for (const int s : {SIGINT, SIGTERM, SIGHUP}) sigaction(s, &action, nullptr);
+}
+
+int bad_input(const std::string& message) {
+  std::cerr << "graspsim sweep: " << message << "\n";
+  return kExitBadInput;
+}
+
+bool parse_count(const std::string& text, std::uint64_t max, std::uint64_t& out) {
+  if (text.empty() || text.size() > 9 || text.find_first_not_of("0123456789") != std::string::npos) return false;
+  out = std::strtoull(text.c_str(), nullptr, 10);
+  return out >= 1 && out <= max;
+}
+
+std::string self_program() {
+  std::error_code ec;
+  const fs::path self = fs::read_symlink("/proc/self/exe", ec);
+  return ec ? std::string("graspsim") : self.string();
+}
+
+// Every axis value, and the fixed sets, as the runs will get them: the scenario's own --set
+// errors (an unknown field, a bad value) before anything runs. Each value is tried once, with the
+// other axes at their first value.
+std::string check_overrides(const Plan& plan) {
+  for (std::size_t a = 0; a <= plan.grid.size(); ++a) {
+    const std::size_t count = a < plan.grid.size() ? plan.grid[a].values.size() : 1;
+    for (std::size_t v = 0; v < count; ++v) {
+      scripting::LoadOptions load;
+      load.sets = plan.sets;
+      for (std::size_t b = 0; b < plan.grid.size(); ++b)
+        load.sets.push_back(plan.grid[b].name + "=" + plan.grid[b].values[b == a ? v : 0]);
+      try {
+        scripting::Scenario::load(plan.scenario, load);
+      } catch (const scripting::ScenarioError& e) {
+        return (a < plan.grid.size() ? "--grid " + plan.grid[a].name + "=" + plan.grid[a].values[v] + ": "
+                                     : std::string()) + e.what();
+      }
+    }
+  }
+  return {};
+}
+
+// Prints "runs done / total" and the time left: one line rewritten on a terminal, else a line
+// per run.
+struct Progress {
+  std::chrono::steady_clock::time_point start = std::chrono::steady_clock::now();
+  bool tty = isatty(STDERR_FILENO);
+  std::size_t kept = 0, total = 0;   // rows already there; runs in the sweep
+  void operator()(std::size_t done, std::size_t of) const {
+    const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    const double left = done > 0 ? elapsed / done * (of - done) : 0.0;
+    std::fprintf(stderr, "%sgraspsim sweep: %zu / %zu runs done, about %.0f s left%s", tty ? "\r" : "",
+                 kept + done, total, left, tty ? "   " : "\n");
+    if (tty && done == of) std::fprintf(stderr, "\n");
+    std::fflush(stderr);
+  }
+};
+
+void plot(const std::string& dir) {
+  const std::string script = GRASPSIM_PLOT_SWEEP;
+  // Debian's python3 (python3-matplotlib, tools/setup.sh), not one earlier on PATH without it.
+  const std::string python = fs::exists("/usr/bin/python3") ? "/usr/bin/python3" : "python3";
+  const std::string command = python + " " + shell_quote(script) + " " +
+                              shell_quote((fs::path(dir) / "sweep.csv").string()) + " --out " +
+                              shell_quote((fs::path(dir) / "sweep.png").string());
+  if (!fs::exists(script) || std::system(command.c_str()) != 0)
+    std::cerr << "graspsim sweep: warning: no plot (" << command
+              << " failed: it needs python3-matplotlib); the table is written\n";
+}
+
+}  // namespace
+
+int sweep_command(const std::vector<std::string>& args) {
+  Plan plan;
+  std::string out;
+  std::uint64_t jobs = std::max(1u, std::thread::hardware_concurrency());
+  bool slurm = false, resume = false, jitter_given = false;
+  for (std::size_t i = 0; i < args.size(); ++i) {
+    const std::string& a = args[i];
+    const std::string* v = (i + 1 < args.size()) ? &args[i + 1] : nullptr;
+    const auto take = [&]() { ++i; return v; };
+    if (a == "-h" || a == "--help") {
+      std::cout << kSweepHelp;
+      return kExitOk;
+    } else if (a == "--grid") {
+      if (!take()) return bad_input("--grid needs NAME=V1,V2,...");
+      try {
+        Axis axis = parse_axis(*v);
+        for (const auto& g : plan.grid)
+          if (g.name == axis.name) return bad_input("--grid " + axis.name + " is given twice");
+        plan.grid.push_back(std::move(axis));
+      } catch (const SweepError& e) {
+        return bad_input(e.what());
+      }
+    } else if (a == "--set") {
+      if (!take() || v->find('=') == std::string::npos || v->front() == '=')
+        return bad_input("--set needs NAME=VALUE" + (v ? " (got '" + *v + "')" : std::string()));
+      plan.sets.push_back(*v);
+    } else if (a == "--seeds") {
+      if (!take() || !parse_count(*v, 1000000, plan.seeds))
+        return bad_input("--seeds needs a whole number from 1 to 1000000" + (v ? " (got '" + *v + "')" : std::string()));
+    } else if (a == "--jitter") {
+      char* end = nullptr;
+      if (take()) plan.jitter = std::strtod(v->c_str(), &end);
+      if (!v || v->empty() || *end != '\0' || !(plan.jitter > 0.0) || !std::isfinite(plan.jitter))
+        return bad_input("--jitter needs an amplitude in m, a number > 0" + (v ? " (got '" + *v + "')" : std::string()));
+      jitter_given = true;
+    } else if (a == "--jobs") {
+      if (!take() || !parse_count(*v, 4096, jobs))
+        return bad_input("--jobs needs a whole number from 1 to 4096" + (v ? " (got '" + *v + "')" : std::string()));
+    } else if (a == "--out") {
+      if (!take() || v->empty() || v->front() == '-')
+        return bad_input("--out needs a folder" + (v ? " (got '" + *v + "')" : std::string()));
+      out = *v;
+    } else if (a == "--keep-traces") {
+      plan.keep_traces = true;
+    } else if (a == "--slurm") {
+      slurm = true;
+    } else if (a == "--resume") {
+      resume = true;
+    } else if (a.rfind("-", 0) == 0) {
+      return bad_input("unknown option '" + a + "' (graspsim sweep --help)");
+    } else if (plan.scenario.empty()) {
+      plan.scenario = a;
+    } else {
+      return bad_input("one scenario at a time (got '" + plan.scenario + "' and '" + a + "')");
+    }
+  }
+  if (plan.scenario.empty()) return bad_input("sweep needs a scenario file (graspsim sweep --help)");
+  if (out.empty()) return bad_input("sweep needs --out DIR");
+  if (plan.grid.empty() && plan.seeds == 0) return bad_input("nothing to sweep: give --grid NAME=V1,V2,... or --seeds N");
+  if (jitter_given && plan.seeds == 0) return bad_input("--jitter is the amplitude of --seeds: it needs --seeds N");
+  if (!fs::is_regular_file(plan.scenario)) return bad_input("no scenario file " + plan.scenario);
+  plan.scenario = fs::absolute(plan.scenario).lexically_normal().string();
+  if (const std::string why = check_overrides(plan); !why.empty()) return bad_input(why);
+
+  // The folder: made if missing; its plan file says which sweep it holds.
+  const std::string dir = fs::absolute(out).lexically_normal().string();
+  const std::string plan_file = (fs::path(dir) / "sweep.plan").string();
+  std::error_code ec;
+  fs::create_directories(fs::path(dir) / "runs", ec);
+  if (ec) return bad_input("--out " + out + ": cannot make the folder: " + ec.message());
+  if (fs::exists(plan_file)) {
+    const std::string there = read_file(plan_file);
+    if (there != plan.text())
+      return bad_input("--out " + out + " holds another sweep (" + plan_file + " differs): choose another folder");
+    if (!resume) return bad_input("--out " + out + " holds this sweep already: --resume to go on with it");
+  } else {
+    std::ofstream file(plan_file);
+    file << plan.text();
+    file.close();
+    if (!file) {
+      std::remove(plan_file.c_str());
+      return bad_input("--out " + out + ": cannot write " + plan_file);
+    }
+  }
+  if (access((fs::path(dir) / "runs").c_str(), W_OK) != 0) return bad_input("--out " + out + ": cannot write in " + dir + "/runs");
+
+  handle_signals();
+  const std::vector<std::size_t> pending = pending_runs(plan, dir);
+  Progress progress;
+  progress.total = plan.size();
+  progress.kept = plan.size() - pending.size();
+  if (progress.kept > 0) std::fprintf(stderr, "graspsim sweep: %zu of %zu runs are done already\n", progress.kept, plan.size());
+  if (!pending.empty()) {
+    if (slurm) {
+      if (const std::string why = run_slurm(self_program(), plan, dir, pending, progress, g_stop); !why.empty()) {
+        std::cerr << "graspsim sweep: " << why << "\n";
+        if (g_stop.load()) return 128 + g_stop_signal.load();
+        return kExitFailed;
+      }
+    } else {
+      try {
+        if (!run_local(self_program(), plan, dir, pending, static_cast<int>(jobs), g_stop, progress)) {
+          std::cerr << "graspsim sweep: stopped; the finished runs are kept (--resume goes on)\n";
+          return 128 + g_stop_signal.load();
+        }
+      } catch (const SweepError& e) {
+        std::cerr << "graspsim sweep: " << e.what() << "\n";
+        return kExitFailed;
+      }
+    }
+  }
+  std::vector<Row> rows;
+  std::vector<std::size_t> missing;
+  for (std::size_t i = 0; i < plan.size(); ++i) {
+    if (auto row = read_row(plan, dir, i)) rows.push_back(std::move(*row));
+    else missing.push_back(i);
+  }
+  try {
+    write_table(plan, dir, rows);
+  } catch (const std::exception& e) {
+    std::cerr << "graspsim sweep: " << e.what() << "\n";
+    return kExitFailed;
+  }
+  plot(dir);
+  std::size_t passed = 0, errors = 0;
+  for (const auto& r : rows) {
+    passed += r.exit_status == 0;
+    errors += r.exit_status >= 2;
+  }
+  std::printf("graspsim sweep: %zu runs: %zu pass, %zu fail, %zu error%s\n  table  %s/sweep.csv, %s/sweep.h5\n",
+              plan.size(), passed, rows.size() - passed - errors, errors,
+              missing.empty() ? "" : (", " + std::to_string(missing.size()) + " without a row").c_str(), dir.c_str(),
+              dir.c_str());
+  if (!missing.empty())
+    std::cerr << "graspsim sweep: runs " << array_list(missing) << " left no row (their output: " << dir
+              << "/runs/*.log" << (slurm ? ", " + dir + "/slurm/task-*.out" : std::string()) << ")\n";
+  return (errors > 0 || !missing.empty()) ? kExitFailed : kExitOk;
+}
+
+int sweep_task_command(const std::vector<std::string>& args) {
+  std::uint64_t index = 0;
+  if (args.size() != 2 || args[1].empty() || args[1].find_first_not_of("0123456789") != std::string::npos)
+    return bad_input("usage: graspsim sweep-task DIR INDEX (a Slurm array task of graspsim sweep --slurm)");
+  index = std::strtoull(args[1].c_str(), nullptr, 10);
+  const std::string dir = args[0], plan_file = (fs::path(dir) / "sweep.plan").string();
+  try {
+    const Plan plan = Plan::parse(read_file(plan_file), plan_file);
+    if (index >= plan.size()) return bad_input(plan_file + " has " + std::to_string(plan.size()) + " runs, not run " + args[1]);
+    const auto start = std::chrono::steady_clock::now();
+    const pid_t pid = start_run(self_program(), plan, dir, index);
+    int status = 0;
+    while (waitpid(pid, &status, 0) < 0)
+      if (errno != EINTR) return bad_input("cannot wait for run " + args[1]);
+    const Row row = finish_run(plan, dir, index, status,
+                               std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+    return row.exit_status < 128 ? kExitOk : row.exit_status;
+  } catch (const SweepError& e) {
+    return bad_input(e.what());
+  }
+}
+
+}  // namespace graspsim::cli

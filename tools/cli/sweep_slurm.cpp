@@ -1,0 +1,74 @@
+// `graspsim sweep --slurm`: the job script, sbatch --array, and waiting on squeue (sweep_slurm.hpp).
+#include "cli/sweep_slurm.hpp"
+
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <thread>
+
+#include "app/sweep_exec.hpp"
+#include "app/sweep_row.hpp"
+
+namespace graspsim::cli {
+
+namespace fs = std::filesystem;
+using namespace app::sweep;
+
+std::string shell_quote(const std::string& s) {
+  std::string out = "'";
+  for (const char c : s) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return out + "'";
+}
+
+std::string run_slurm(const std::string& program, const Plan& plan, const std::string& dir,
+                      const std::vector<std::size_t>& pending,
+                      const std::function<void(std::size_t, std::size_t)>& progress, const std::atomic<bool>& stop) {
+  const fs::path slurm = fs::path(dir) / "slurm";
+  std::error_code ec;
+  fs::create_directories(slurm, ec);
+  if (ec) return "cannot make " + slurm.string() + ": " + ec.message();
+  const std::string script = (slurm / "job.sh").string();
+  {
+    std::ofstream out(script, std::ios::trunc);
+    out << "#!/bin/sh\n"
+        << "# One run of the graspsim sweep in " << dir << " per array task (graspsim sweep --slurm).\n"
+        << "#SBATCH --job-name=graspsim-sweep\n"
+        << "#SBATCH --ntasks=1\n"
+        << "#SBATCH --cpus-per-task=1\n"
+        << "#SBATCH --output=" << (slurm / "task-%a.out").string() << "\n"
+        << "exec " << shell_quote(program) << " sweep-task " << shell_quote(dir) << " \"$SLURM_ARRAY_TASK_ID\"\n";
+    if (!out) return "cannot write " + script;
+  }
+  const std::string submit = "sbatch --parsable --array=" + array_list(pending) + " " + shell_quote(script);
+  FILE* p = popen((submit + " 2>&1").c_str(), "r");
+  if (!p) return "cannot run sbatch";
+  std::string reply;
+  char buf[256];
+  while (std::fgets(buf, sizeof buf, p)) reply += buf;
+  const int status = pclose(p);
+  const std::string job = reply.substr(0, reply.find_first_of(";\n"));
+  if (status != 0 || job.empty() || job.find_first_not_of("0123456789") != std::string::npos)
+    return "sbatch refused the job array (" + submit + "): " + reply;
+  std::fprintf(stderr, "graspsim sweep: submitted %zu runs as Slurm job array %s (%s)\n", pending.size(), job.c_str(),
+               script.c_str());
+  std::size_t reported = 0;
+  for (;;) {
+    if (stop.load()) {
+      std::system(("scancel " + job).c_str());
+      return "stopped: cancelled job " + job;
+    }
+    FILE* q = popen(("squeue -h -j " + job + " -o %i 2>/dev/null").c_str(), "r");
+    std::string queued;
+    while (q && std::fgets(buf, sizeof buf, q)) queued += buf;
+    if (q) pclose(q);
+    std::size_t done = 0;
+    for (const std::size_t i : pending) done += read_row(plan, dir, i).has_value();
+    if (done != reported) progress(reported = done, pending.size());
+    if (queued.find_first_not_of(" \n") == std::string::npos) return {};
+    std::this_thread::sleep_for(std::chrono::milliseconds(500));
+  }
+}
+
+}  // namespace graspsim::cli
