@@ -41,7 +41,7 @@ constexpr const char* kUsage =
     "                [--no-trace | --record LOOP[:EVERY],...]\n"
     "       graspsim replay TRACE.h5 [--out NEW.h5] [--set NAME=VALUE]...\n"
     "       graspsim repair TRACE.h5\n"
-    "       graspsim view TRACE.h5 [--port N] [--open]\n"
+    "       graspsim view TRACE.h5 [B.h5] [--port N] [--open]\n"
     "       graspsim compare A.h5 B.h5 [--atol X] [--rtol X] [--tol PATTERN=ATOL[,RTOL]]...\n"
     "                [--bitwise] [--attributes] [--all-ticks] [--all] [--only LOOP]... [--json]\n"
     "       graspsim --help | --version\n";
@@ -124,7 +124,7 @@ constexpr const char* kHelp =
     "Compares two traces tick by tick and names the first tick, time, quantity, object or\n"
     "finger and component where they part. Exit status 0 same, 1 different, 2 bad input.\n"
     "\n"
-    "usage: graspsim view TRACE.h5 [--port N] [--open]   (graspsim view --help for more)\n"
+    "usage: graspsim view TRACE.h5 [B.h5] [--port N] [--open]   (graspsim view --help for more)\n"
     "\n"
     "Shows a trace in 3D in the browser, served on 127.0.0.1 until Ctrl-C.\n";
 
