@@ -43,7 +43,7 @@ constexpr const char* kUsage =
     "       graspsim repair TRACE.h5\n"
     "       graspsim view TRACE.h5 [B.h5] [--port N] [--open]\n"
     "       graspsim compare A.h5 B.h5 [--atol X] [--rtol X] [--tol PATTERN=ATOL[,RTOL]]...\n"
-    "                [--bitwise] [--attributes] [--all-ticks] [--all] [--only LOOP]... [--json]\n"
+    "                [--bitwise] [--attributes] [--all-ticks] [--all] [--only LOOP]... [--json] [--view]\n"
     "       graspsim --help | --version\n";
 
 constexpr const char* kHelp =
@@ -167,6 +167,11 @@ constexpr const char* kCompareHelp =
     "                       trace holds is an error\n"
     "  --json               one JSON object on stdout instead of the table (fields:\n"
     "                       recordings/README.md, \"Comparing traces\")\n"
+    "  --view               then show both runs in the browser, as `graspsim view A.h5 B.h5`\n"
+    "                       does (B ghosted, the first divergence marked), until Ctrl-C; exit\n"
+    "                       status then that of the view. The mark is the first divergence at\n"
+    "                       tolerance 0 over every loop: no --atol, --rtol, --tol, --bitwise\n"
+    "                       or --only with it\n"
     "\n"
     "Tables one trace holds and the other does not (/devices/FINGER of a device session\n"
     "against its scripted run, a loop one trace did not --record) are listed as \"only in A\"\n"
@@ -449,7 +454,7 @@ int compare_command(const std::vector<std::string>& args) {
   namespace rec = graspsim::recordings;
   std::vector<std::string> files;
   rec::CompareOptions options;
-  bool json = false, all = false, tolerances = false;
+  bool json = false, all = false, tolerances = false, view = false;
   for (std::size_t i = 0; i < args.size(); ++i) {
     const std::string& a = args[i];
     const auto value = [&]() -> const std::string* {
@@ -500,6 +505,8 @@ int compare_command(const std::vector<std::string>& args) {
       }
     } else if (a == "--json") {
       json = true;
+    } else if (a == "--view") {
+      view = true;
     } else if (a.rfind("-", 0) == 0) {
       return bad_input("unknown option '" + a + "'\n" + kUsage);
     } else {
@@ -515,6 +522,9 @@ int compare_command(const std::vector<std::string>& args) {
                        kUsage);
   if (options.bitwise && tolerances)
     return input_error("--bitwise compares exact bits: it takes no --atol, --rtol or --tol");
+  if (view && (tolerances || options.bitwise || !options.only.empty()))
+    return input_error("--view marks the first divergence at tolerance 0 over every loop: it takes no --atol, --rtol, "
+                       "--tol, --bitwise or --only");
   rec::CompareResult result;
   try {
     result = rec::compare_traces(files[0], files[1], options);
@@ -522,6 +532,10 @@ int compare_command(const std::vector<std::string>& args) {
     return input_error(e.what());
   }
   std::cout << (json ? graspsim::app::compare_json(result) : graspsim::app::compare_table(result, all));
+  if (view) {
+    std::cout.flush();
+    return graspsim::cli::view_command({files[0], files[1]});
+  }
   return result.same() ? kExitOk : kExitFailed;
 }
 

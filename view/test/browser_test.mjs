@@ -349,6 +349,9 @@ async function checkBadInput() {
   const lift = join(tmp, 'two_finger_lift.h5');
   expect2([lift, join(tmp, 'missing_b.h5')], /missing_b\.h5: no such file/, 'a second trace that is missing');
   expect2([lift, lift, lift], /at most two traces/, 'three traces');
+  const r = run(['compare', lift, lift, '--view', '--atol', '1']);
+  check(r.status === 2 && /--view marks the first divergence at tolerance 0/.test(r.out),
+        `compare --view with a tolerance: exit ${r.status}, "${r.out.trim().split('\n').pop()}"`);
   const help = run(['view', '--help']);
   check(help.status === 0 && help.out.includes('--port N') && help.out.includes('exit status'), '--help documents the command');
 }

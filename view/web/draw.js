@@ -111,7 +111,8 @@ export class SceneView {
     this.ghosts = [];
     this.ghostFingers = [];
     this.resize();
-    window.addEventListener('resize', () => this.resize());
+    // The stage's size follows the window and the timeline's wrapping.
+    new ResizeObserver(() => this.resize()).observe(container);
   }
 
   // The second run of an overlay: its bodies ghosted, its god-objects as faint spheres.

@@ -9,6 +9,7 @@ const HEIGHT = 120;    // px: one panel's plot area
 const MARGIN = 44;     // px: left, for the y labels
 
 function number(x) {
+  if (x === 0) return '0';
   const a = Math.abs(x);
   return a !== 0 && (a < 1e-3 || a >= 1e4) ? x.toExponential(2) : x.toFixed(a < 0.1 ? 4 : 3);
 }
@@ -151,7 +152,7 @@ export class Plots {
     this.marker = null;
     this.tick = null;
     this.resize();
-    window.addEventListener('resize', () => this.resize());
+    new ResizeObserver(() => this.resize()).observe(container);
   }
   resize() {
     const w = Math.max(this.container.clientWidth - 12, 120);
