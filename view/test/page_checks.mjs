@@ -72,34 +72,40 @@ export async function checkCircleMuDepth(t, page, trace, name, mu) {
   }
 }
 
-// Step buttons from a physics tick (a tick of every loop): exactly one period of each loop.
+// Step buttons from a physics tick (a tick of every loop): exactly one period of each loop. The
+// buttons are clicked in the page (their click handlers), all in one call.
 export async function checkSteps(t, page, trace, name, rates) {
   const { check, hook } = t;
   const start = trace.physics_tick[trace.physics_tick.length >> 1];
   const period = { servo: 1, haptic: rates.servo / rates.haptic, physics: rates.servo / rates.physics };
-  for (const [button, loop, dir] of [['#sfwd', 'servo', 1], ['#hfwd', 'haptic', 1], ['#fwd', 'physics', 1],
-                                     ['#sback', 'servo', -1], ['#hback', 'haptic', -1], ['#back', 'physics', -1]]) {
-    await hook(page, (x) => window.graspsimView.seek(x), start);
-    await page.locator(button).click();
-    const got = await hook(page, () => window.graspsimView.tick());
-    check(got === start + dir * period[loop], `${name}: ${button} moves tick ${start} to ${got}, one ${loop} period (${dir * period[loop]})`);
-  }
+  const buttons = [['sfwd', 'servo', 1], ['hfwd', 'haptic', 1], ['fwd', 'physics', 1],
+                   ['sback', 'servo', -1], ['hback', 'haptic', -1], ['back', 'physics', -1]];
+  const got = await hook(page, ([ids, from]) => ids.map((id) => {
+    window.graspsimView.seek(from);
+    document.getElementById(id).click();
+    return window.graspsimView.tick();
+  }), [buttons.map((b) => b[0]), start]);
+  buttons.forEach(([id, loop, dir], k) =>
+    check(got[k] === start + dir * period[loop], `${name}: #${id} moves tick ${start} to ${got[k]}, one ${loop} period (${dir * period[loop]})`));
   await hook(page, (x) => window.graspsimView.seek(x), start);
   await page.keyboard.press('Shift+ArrowRight');
-  const got = await hook(page, () => window.graspsimView.tick());
-  check(got === start + period.haptic, `${name}: Shift+Right moves tick ${start} to ${got}, one haptic period`);
+  const key = await hook(page, () => window.graspsimView.tick());
+  check(key === start + period.haptic, `${name}: Shift+Right moves tick ${start} to ${key}, one haptic period`);
 }
 
 // The view buttons put the camera on an axis through the point it looks at.
 export async function checkViews(t, page, name) {
   const { check, hook } = t;
-  for (const [axis, want] of [['x', [1, 0, 0]], ['y', [0, -1, 0]], ['z', [0, 0, 1]]]) {
-    await page.locator(`#view${axis}`).click();
-    const c = await hook(page, () => window.graspsimView.camera());
-    const d = c.position.map((x, k) => x - c.target[k]), n = Math.hypot(...d);
-    const cos = d.reduce((s, x, k) => s + x * want[k], 0) / n;
+  const axes = [['x', [1, 0, 0]], ['y', [0, -1, 0]], ['z', [0, 0, 1]]];
+  const cameras = await hook(page, (ids) => ids.map((a) => {
+    document.getElementById(`view${a}`).click();
+    return window.graspsimView.camera();
+  }), axes.map((a) => a[0]));
+  axes.forEach(([axis, want], k) => {
+    const c = cameras[k], d = c.position.map((x, i) => x - c.target[i]), n = Math.hypot(...d);
+    const cos = d.reduce((s, x, i) => s + x * want[i], 0) / n;
     check(cos > 0.9999, `${name}: the '${axis}' view looks along the ${axis} axis (camera direction . axis = ${cos.toFixed(6)})`);
-  }
+  });
 }
 
 // The grasp axis where the grasp rule holds a body (grasp area > 0): between the two touching
