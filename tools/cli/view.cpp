@@ -11,6 +11,7 @@
 #include <iostream>
 #include <memory>
 #include <thread>
+#include <utility>
 
 #include "cli/report.hpp"
 #include "view/server/overlay.hpp"
@@ -30,7 +31,8 @@ constexpr const char* kViewHelp =
     "until Ctrl-C. The page draws the floor, every body with its shape (from the trace's own\n"
     "scenario), and per finger the HIP, the god-object (a sphere of the pad radius) coloured\n"
     "free / stick / slip, the friction circle in contact (radius mu depth about the surface\n"
-    "point) and the force on the finger as an arrow (1 cm per N); a timeline plays, pauses,\n"
+    "point) and the force on the finger as an arrow (1 cm per N), the grasp axis and its\n"
+    "torsion where the grasp rule holds a body; a timeline plays, pauses,\n"
     "changes speed (0.1x to 10x), scrubs and steps one physics, haptic or servo tick. Drag to\n"
     "orbit, right-drag to pan, wheel to zoom. A cut trace (a run killed or stopped early) is\n"
     "shown up to its last tick, with a note. Nothing is fetched beyond 127.0.0.1.\n"
@@ -46,7 +48,8 @@ constexpr const char* kViewHelp =
     "\n"
     "exit status: 0 stopped by Ctrl-C (SIGINT), SIGTERM or SIGHUP; 2 bad input: bad arguments,\n"
     "a missing file, a file that is not a graspsim trace or holds no physics tick, a port that\n"
-    "is in use, or the page's files missing from the build (nothing is served then).\n";
+    "is in use, two traces that cannot be compared (rates or schema that differ), or the\n"
+    "page's files missing from the build (nothing is served then).\n";
 
 int bad(const std::string& message) {
   std::cerr << "graspsim view: " << message << "\n";
@@ -60,8 +63,8 @@ void open_browser(const std::string& url) {
     std::cerr << "graspsim view: --open: xdg-open could not be started; open " << url << " yourself\n";
 }
 
-// B of `graspsim view A B`: its scene, and where it first differs from A.
-void add_ghost(view::ViewServer& server, const std::string& a, const std::string& b) {
+// B of `graspsim view A B`: its scene packed, and where it first differs from A (/compare.json).
+std::pair<view::Packed, std::string> load_ghost(const std::string& a, const std::string& b) {
   const view::ViewScene scene = view::load_scene(b);
   if (!scene.note.empty()) std::cerr << "graspsim view: note: " << b << ": " << scene.note << "\n";
   const view::Divergence d = view::first_divergence(a, b);
@@ -70,7 +73,7 @@ void add_ghost(view::ViewServer& server, const std::string& a, const std::string
                 d.dataset.c_str());
   else
     std::printf("graspsim view: %s and %s do not differ\n", a.c_str(), b.c_str());
-  server.add_overlay(view::pack_scene(scene), view::divergence_json(a, b, d));
+  return {view::pack_scene(scene), view::divergence_json(a, b, d)};
 }
 
 }  // namespace
@@ -125,8 +128,10 @@ int view_command(const std::vector<std::string>& args) {
     packed = view::pack_scene(scene);
     if (!scene.note.empty()) std::cerr << "graspsim view: note: " << scene.note << "\n";
     const std::size_t blob_bytes = packed.blob.size();
+    std::pair<view::Packed, std::string> overlay;   // read before the port is taken
+    if (!ghost.empty()) overlay = load_ghost(trace, ghost);
     server = std::make_unique<view::ViewServer>(std::move(packed), web, port);
-    if (!ghost.empty()) add_ghost(*server, trace, ghost);
+    if (!ghost.empty()) server->add_overlay(std::move(overlay.first), std::move(overlay.second));
     const double read_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     std::printf("graspsim view: %s: %zu physics ticks, t = 0 to %.3f s (%.1f MB for the page, read in %.2f s)\n",
                 trace.c_str(), physics_rows, shown, blob_bytes / 1e6, read_s);

@@ -354,6 +354,9 @@ async function checkBadInput() {
   const lift = join(tmp, 'two_finger_lift.h5');
   expect2([lift, join(tmp, 'missing_b.h5')], /missing_b\.h5: no such file/, 'a second trace that is missing');
   expect2([lift, lift, lift], /at most two traces/, 'three traces');
+  const fast = join(tmp, 'physics_100hz.h5');
+  run(['run', join(src, 'scenarios/two_finger_lift.lua'), '--set', 'rates.physics=100', '--out', fast, '--quiet']);
+  expect2([lift, fast], /cannot compare .* different rates/, 'two traces at different rates');
   const r = run(['compare', lift, lift, '--view', '--atol', '1']);
   check(r.status === 2 && /--view marks the first divergence at tolerance 0/.test(r.out),
         `compare --view with a tolerance: exit ${r.status}, "${r.out.trim().split('\n').pop()}"`);
