@@ -23,8 +23,10 @@ function columns(scene, buffer) {
 
 const slice = (a, row, w) => Array.from(a.subarray(row * w, row * w + w));
 
-async function getJson(path) {
+// The JSON at `path`; with `optional`, null where the server has none (404).
+async function getJson(path, optional = false) {
   const r = await fetch(path);
+  if (optional && r.status === 404) return null;
   if (!r.ok) throw new Error(`${path}: HTTP ${r.status}`);
   return r.json();
 }
@@ -35,12 +37,8 @@ async function getBlob(path) {
 }
 // A run: its scene and columns. The second run of an overlay is at b/; null when none is served.
 async function loadRun(prefix, optional) {
-  if (optional) {
-    const probe = await fetch(`${prefix}scene.json`);
-    if (probe.status === 404) return null;
-  }
-  const [scene, buffer] = await Promise.all([getJson(`${prefix}scene.json`), getBlob(`${prefix}trace.bin`)]);
-  return { scene, col: columns(scene, buffer) };
+  const scene = await getJson(`${prefix}scene.json`, optional);
+  return scene && { scene, col: columns(scene, await getBlob(`${prefix}trace.bin`)) };
 }
 
 // The panels beside the scene: forces per finger (and B's, faint), heights, contact state.
@@ -68,8 +66,7 @@ function panels(a, sa, b, sb) {
 
 async function start() {
   const t0 = performance.now();
-  const a = await loadRun('', false);
-  const b = await loadRun('b/', true);
+  const [a, b] = await Promise.all([loadRun('', false), loadRun('b/', true)]);
   const compare = b ? await getJson('compare.json') : null;
   const { scene, col } = a;
   const physicsTicks = col.physics_tick, hapticTicks = col.haptic_tick;
