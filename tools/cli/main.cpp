@@ -45,9 +45,9 @@ constexpr const char* kUsage =
     "                --out DIR [--keep-traces] [--slurm] [--resume]\n"
     "       graspsim replay TRACE.h5 [--out NEW.h5] [--set NAME=VALUE]...\n"
     "       graspsim repair TRACE.h5\n"
-    "       graspsim view TRACE.h5 [--port N] [--open]\n"
+    "       graspsim view TRACE.h5 [B.h5] [--port N] [--open]\n"
     "       graspsim compare A.h5 B.h5 [--atol X] [--rtol X] [--tol PATTERN=ATOL[,RTOL]]...\n"
-    "                [--bitwise] [--attributes] [--all-ticks] [--all] [--only LOOP]... [--json]\n"
+    "                [--bitwise] [--attributes] [--all-ticks] [--all] [--only LOOP]... [--json] [--view]\n"
     "       graspsim --help | --version\n";
 
 constexpr const char* kHelp =
@@ -137,7 +137,7 @@ constexpr const char* kHelp =
     "Compares two traces tick by tick and names the first tick, time, quantity, object or\n"
     "finger and component where they part. Exit status 0 same, 1 different, 2 bad input.\n"
     "\n"
-    "usage: graspsim view TRACE.h5 [--port N] [--open]   (graspsim view --help for more)\n"
+    "usage: graspsim view TRACE.h5 [B.h5] [--port N] [--open]   (graspsim view --help for more)\n"
     "\n"
     "Shows a trace in 3D in the browser, served on 127.0.0.1 until Ctrl-C.\n";
 
@@ -180,6 +180,11 @@ constexpr const char* kCompareHelp =
     "                       trace holds is an error\n"
     "  --json               one JSON object on stdout instead of the table (fields:\n"
     "                       recordings/README.md, \"Comparing traces\")\n"
+    "  --view               then show both runs in the browser, as `graspsim view A.h5 B.h5`\n"
+    "                       does (B ghosted, the first divergence marked), until Ctrl-C; exit\n"
+    "                       status then that of the view. The mark is the first divergence at\n"
+    "                       tolerance 0 over every loop: no --atol, --rtol, --tol, --bitwise\n"
+    "                       or --only with it\n"
     "\n"
     "Tables one trace holds and the other does not (/devices/FINGER of a device session\n"
     "against its scripted run, a loop one trace did not --record) are listed as \"only in A\"\n"
@@ -498,7 +503,7 @@ int compare_command(const std::vector<std::string>& args) {
   namespace rec = graspsim::recordings;
   std::vector<std::string> files;
   rec::CompareOptions options;
-  bool json = false, all = false, tolerances = false;
+  bool json = false, all = false, tolerances = false, view = false;
   for (std::size_t i = 0; i < args.size(); ++i) {
     const std::string& a = args[i];
     const auto value = [&]() -> const std::string* {
@@ -549,6 +554,8 @@ int compare_command(const std::vector<std::string>& args) {
       }
     } else if (a == "--json") {
       json = true;
+    } else if (a == "--view") {
+      view = true;
     } else if (a.rfind("-", 0) == 0) {
       return bad_input("unknown option '" + a + "'\n" + kUsage);
     } else {
@@ -564,6 +571,9 @@ int compare_command(const std::vector<std::string>& args) {
                        kUsage);
   if (options.bitwise && tolerances)
     return input_error("--bitwise compares exact bits: it takes no --atol, --rtol or --tol");
+  if (view && (tolerances || options.bitwise || !options.only.empty()))
+    return input_error("--view marks the first divergence at tolerance 0 over every loop: it takes no --atol, --rtol, "
+                       "--tol, --bitwise or --only");
   rec::CompareResult result;
   try {
     result = rec::compare_traces(files[0], files[1], options);
@@ -571,6 +581,10 @@ int compare_command(const std::vector<std::string>& args) {
     return input_error(e.what());
   }
   std::cout << (json ? graspsim::app::compare_json(result) : graspsim::app::compare_table(result, all));
+  if (view) {
+    std::cout.flush();
+    return graspsim::cli::view_command({files[0], files[1]});
+  }
   return result.same() ? kExitOk : kExitFailed;
 }
 

@@ -11,8 +11,10 @@
 #include <iostream>
 #include <memory>
 #include <thread>
+#include <utility>
 
 #include "cli/report.hpp"
+#include "view/server/overlay.hpp"
 #include "view/server/server.hpp"
 
 extern char** environ;
@@ -23,16 +25,21 @@ namespace {
 constexpr int kDefaultPort = 8717;
 
 constexpr const char* kViewHelp =
-    "usage: graspsim view TRACE.h5 [--port N] [--open]\n"
+    "usage: graspsim view TRACE.h5 [B.h5] [--port N] [--open]\n"
     "\n"
     "Shows a trace in 3D in the browser: serves a page on 127.0.0.1, prints its URL and runs\n"
     "until Ctrl-C. The page draws the floor, every body with its shape (from the trace's own\n"
     "scenario), and per finger the HIP, the god-object (a sphere of the pad radius) coloured\n"
     "free / stick / slip, the friction circle in contact (radius mu depth about the surface\n"
-    "point) and the force on the finger as an arrow (1 cm per N); a timeline plays, pauses,\n"
-    "changes speed (0.1x to 10x), scrubs and steps one physics tick. Drag to\n"
+    "point) and the force on the finger as an arrow (1 cm per N), the grasp axis and its\n"
+    "torsion where the grasp rule holds a body; a timeline plays, pauses,\n"
+    "changes speed (0.1x to 10x), scrubs and steps one physics, haptic or servo tick. Drag to\n"
     "orbit, right-drag to pan, wheel to zoom. A cut trace (a run killed or stopped early) is\n"
     "shown up to its last tick, with a note. Nothing is fetched beyond 127.0.0.1.\n"
+    "Beside the scene, time series linked to the timeline (click one to go there): per finger\n"
+    "the normal force, the tangential force and mu f_n, each body's height, the contact state.\n"
+    "With a second trace B, both runs are drawn, B ghosted (transparent), and the timeline marks\n"
+    "the first tick where they differ, as `graspsim compare TRACE B` finds it.\n"
     "\n"
     "options:\n"
     "  --port N   port on 127.0.0.1 (default 8717; 0: any free port, printed)\n"
@@ -41,7 +48,8 @@ constexpr const char* kViewHelp =
     "\n"
     "exit status: 0 stopped by Ctrl-C (SIGINT), SIGTERM or SIGHUP; 2 bad input: bad arguments,\n"
     "a missing file, a file that is not a graspsim trace or holds no physics tick, a port that\n"
-    "is in use, or the page's files missing from the build (nothing is served then).\n";
+    "is in use, two traces that cannot be compared (rates or schema that differ), or the\n"
+    "page's files missing from the build (nothing is served then).\n";
 
 int bad(const std::string& message) {
   std::cerr << "graspsim view: " << message << "\n";
@@ -55,10 +63,23 @@ void open_browser(const std::string& url) {
     std::cerr << "graspsim view: --open: xdg-open could not be started; open " << url << " yourself\n";
 }
 
+// B of `graspsim view A B`: its scene packed, and where it first differs from A (/compare.json).
+std::pair<view::Packed, std::string> load_ghost(const std::string& a, const std::string& b) {
+  const view::ViewScene scene = view::load_scene(b);
+  if (!scene.note.empty()) std::cerr << "graspsim view: note: " << b << ": " << scene.note << "\n";
+  const view::Divergence d = view::first_divergence(a, b);
+  if (d.tick)
+    std::printf("graspsim view: %s first differs from %s at servo tick %lld (%s)\n", b.c_str(), a.c_str(), *d.tick,
+                d.dataset.c_str());
+  else
+    std::printf("graspsim view: %s and %s do not differ\n", a.c_str(), b.c_str());
+  return {view::pack_scene(scene), view::divergence_json(a, b, d)};
+}
+
 }  // namespace
 
 int view_command(const std::vector<std::string>& args) {
-  std::string trace;
+  std::string trace, ghost;
   int port = kDefaultPort;
   bool open = false;
   for (std::size_t i = 0; i < args.size(); ++i) {
@@ -76,14 +97,16 @@ int view_command(const std::vector<std::string>& args) {
     } else if (a == "--open") {
       open = true;
     } else if (a.rfind("-", 0) == 0) {
-      return bad("unknown option '" + a + "'\nusage: graspsim view TRACE.h5 [--port N] [--open]");
+      return bad("unknown option '" + a + "'\nusage: graspsim view TRACE.h5 [B.h5] [--port N] [--open]");
     } else if (trace.empty()) {
       trace = a;
+    } else if (ghost.empty()) {
+      ghost = a;
     } else {
-      return bad("one trace at a time (got '" + trace + "' and '" + a + "')");
+      return bad("at most two traces (got '" + trace + "', '" + ghost + "' and '" + a + "')");
     }
   }
-  if (trace.empty()) return bad("view needs a trace file\nusage: graspsim view TRACE.h5 [--port N] [--open]");
+  if (trace.empty()) return bad("view needs a trace file\nusage: graspsim view TRACE.h5 [B.h5] [--port N] [--open]");
 
   // Stop signals are taken by one thread (sigwait), blocked in every other, the server's
   // workers included: they are created after this.
@@ -105,7 +128,10 @@ int view_command(const std::vector<std::string>& args) {
     packed = view::pack_scene(scene);
     if (!scene.note.empty()) std::cerr << "graspsim view: note: " << scene.note << "\n";
     const std::size_t blob_bytes = packed.blob.size();
+    std::pair<view::Packed, std::string> overlay;   // read before the port is taken
+    if (!ghost.empty()) overlay = load_ghost(trace, ghost);
     server = std::make_unique<view::ViewServer>(std::move(packed), web, port);
+    if (!ghost.empty()) server->add_overlay(std::move(overlay.first), std::move(overlay.second));
     const double read_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     std::printf("graspsim view: %s: %zu physics ticks, t = 0 to %.3f s (%.1f MB for the page, read in %.2f s)\n",
                 trace.c_str(), physics_rows, shown, blob_bytes / 1e6, read_s);

@@ -110,6 +110,9 @@ Packed pack_scene(const ViewScene& s) {
     const BodyView& b = s.bodies[i];
     blob.add("body/" + std::to_string(i) + "/position", b.position, "f64");
     blob.add("body/" + std::to_string(i) + "/quaternion", b.quaternion, "f64");
+    for (const auto& [name, values] : {std::pair{"grasp_area", &b.grasp_area}, {"torsion", &b.torsion},
+                                       {"floor_contacts", &b.floor_contacts}, {"body_contacts", &b.body_contacts}})
+      blob.add("body/" + std::to_string(i) + "/" + name, *values, "f64");
     bodies += std::string(i ? ",\n    " : "") + "{\"name\": " + json_string(b.name) + ", \"shape\": " + shape_json(b) + "}";
   }
   for (std::size_t j = 0; j < s.fingers.size(); ++j) {
@@ -121,6 +124,9 @@ Packed pack_scene(const ViewScene& s) {
     blob.add(p + "surface_point", f.surface_point, "f64");
     blob.add(p + "friction_radius", f.friction_radius, "f64");
     blob.add(p + "state", f.state, "i8");
+    blob.add(p + "depth", f.depth, "f64");
+    blob.add(p + "slip", f.slip, "f64");
+    blob.add(p + "body", f.body, "f64");
     fingers += std::string(j ? ",\n    " : "") + "{\"name\": " + json_string(f.name) + ", \"radius\": " + number(f.radius) + "}";
   }
   Packed out;

@@ -19,7 +19,10 @@ struct Packed {
 // "body/<i>/position" (float64, 3 per /physics row), "body/<i>/quaternion" (float64, 4 per row,
 // w x y z), "finger/<j>/hip", "finger/<j>/god_object", "finger/<j>/force",
 // "finger/<j>/surface_point" (float64, 3 per /haptic row), "finger/<j>/friction_radius"
-// (float64, 1 per row), "finger/<j>/state" (int8, 1 per row).
+// (float64, 1 per row), "finger/<j>/state" (int8, 1 per row); for the time series and the grasp
+// axis "body/<i>/grasp_area" (m^2), "body/<i>/torsion" (N m), "body/<i>/floor_contacts",
+// "body/<i>/body_contacts" (counts) per /physics row and "finger/<j>/depth", "finger/<j>/slip"
+// (m), "finger/<j>/body" (index, -2 floor, -1 none) per /haptic row, all float64.
 Packed pack_scene(const ViewScene& scene);
 
 // `text` as a JSON string literal, quotes included.

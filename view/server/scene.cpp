@@ -167,6 +167,32 @@ void load_columns(ViewScene& s, const std::vector<std::string>& columns) {
   }
 }
 
+// The columns the time series and the grasp axis read: the first `rows` values of `path`, or
+// zeros where an older trace lacks it.
+std::vector<double> plot_column(const std::string& trace, const std::vector<std::string>& columns,
+                                const std::string& path, std::size_t rows) {
+  if (std::find(columns.begin(), columns.end(), path) == columns.end()) return std::vector<double>(rows, 0.0);
+  const rec::Dataset d = column(trace, path, 1, rows);
+  return {d.values.begin(), d.values.begin() + static_cast<std::ptrdiff_t>(rows)};
+}
+
+void load_plot_columns(ViewScene& s, const std::vector<std::string>& columns) {
+  const std::size_t np = s.physics_tick.size(), nh = s.haptic_tick.size();
+  for (BodyView& b : s.bodies) {
+    const std::string base = "/physics/objects/" + b.name + "/";
+    b.grasp_area = plot_column(s.trace, columns, base + "grasp_area", np);
+    b.torsion = plot_column(s.trace, columns, base + "torsion", np);
+    b.floor_contacts = plot_column(s.trace, columns, base + "floor_contacts", np);
+    b.body_contacts = plot_column(s.trace, columns, base + "body_contacts", np);
+  }
+  for (FingerView& f : s.fingers) {
+    const std::string h = "/haptic/fingers/" + f.name + "/";
+    f.depth = plot_column(s.trace, columns, h + "depth", nh);
+    f.slip = plot_column(s.trace, columns, h + "slip", nh);
+    f.body = plot_column(s.trace, columns, h + "body", nh);
+  }
+}
+
 }  // namespace
 
 ViewScene load_scene(const std::string& trace) {
@@ -188,15 +214,25 @@ ViewScene load_scene(const std::string& trace) {
       const Model& m = scenario->model();
       s.floor = m.floor.enabled;
       s.floor_height = m.floor.height;
-      for (const BodyParams& b : m.bodies) s.bodies.push_back({b.name, true, b.shape, {}, {}});
-      for (const FingerParams& f : m.fingers) s.fingers.push_back({f.name, f.radius, {}, {}, {}, {}, {}, {}});
+      for (const BodyParams& b : m.bodies) {
+        BodyView& v = s.bodies.emplace_back();
+        v.name = b.name;
+        v.shape_known = true;
+        v.shape = b.shape;
+      }
+      for (const FingerParams& f : m.fingers) {
+        FingerView& v = s.fingers.emplace_back();
+        v.name = f.name;
+        v.radius = f.radius;
+      }
     } else {
       // Names from the columns, shapes unknown: the page draws placeholders and says why.
       s.floor = true;
-      for (const std::string& b : names_under(columns, "/physics/objects/")) s.bodies.push_back({b, false, {}, {}, {}});
-      for (const std::string& f : names_under(columns, "/haptic/fingers/")) s.fingers.push_back({f, 0.0, {}, {}, {}, {}, {}, {}});
+      for (const std::string& b : names_under(columns, "/physics/objects/")) s.bodies.emplace_back().name = b;
+      for (const std::string& f : names_under(columns, "/haptic/fingers/")) s.fingers.emplace_back().name = f;
     }
     load_columns(s, columns);
+    load_plot_columns(s, columns);
     if (s.status != "complete") s.note = cut_note(s);
     if (!scenario)
       s.note += (s.note.empty() ? "" : " ") + std::string("The recorded scenario does not load here (") + why +

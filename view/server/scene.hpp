@@ -25,6 +25,11 @@ struct BodyView {
   Shape shape;                    // body frame (origin at the centre of mass)
   std::vector<double> position;   // m, world: 3 per /physics row (centre of mass)
   std::vector<double> quaternion; // 1: 4 per /physics row, w, x, y, z, body to world
+  // Per /physics row, for the time series and the grasp axis (0 where the trace lacks the column):
+  std::vector<double> grasp_area;      // m^2: friction-circle area of a two-finger grasp (0: none)
+  std::vector<double> torsion;         // N m: gravity-drop torque about the grasp axis
+  std::vector<double> floor_contacts;  // 1: floor points touching the floor
+  std::vector<double> body_contacts;   // 1: contact points with other bodies
 };
 
 struct FingerView {
@@ -36,6 +41,9 @@ struct FingerView {
   std::vector<std::int8_t> state; // 1 per /haptic row: 0 free, 1 stick, 2 slip
   std::vector<double> surface_point;   // m, world: 3 per /haptic row, the HIP on the contacted face
   std::vector<double> friction_radius; // m: 1 per /haptic row, mu depth (the friction circle)
+  std::vector<double> depth;      // m: 1 per /haptic row, |surface point - HIP| (0 free)
+  std::vector<double> slip;       // m: 1 per /haptic row, the god-object's slide this tick
+  std::vector<double> body;       // 1 per /haptic row: contacted body index, -2 floor, -1 none
 };
 
 struct ViewScene {

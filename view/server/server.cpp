@@ -23,6 +23,8 @@ std::string web_folder() {
 struct ViewServer::Impl {
   httplib::Server http;
   Packed packed;
+  Packed overlay;            // the second run of `graspsim view A B`
+  std::string compare;       // /compare.json
 };
 
 ViewServer::ViewServer(Packed packed, std::string web, int port) : impl_(std::make_unique<Impl>()) {
@@ -65,6 +67,21 @@ ViewServer::ViewServer(Packed packed, std::string web, int port) : impl_(std::ma
                       " (the port is in use, or needs privileges): choose another with --port N, or --port 0 for any free one");
     port_ = port;
   }
+}
+
+void ViewServer::add_overlay(Packed b, std::string compare_json) {
+  impl_->overlay = std::move(b);
+  impl_->compare = std::move(compare_json);
+  const Impl& i = *impl_;
+  const auto bytes = [](const std::string& body, const char* type) {
+    return [&body, type](const httplib::Request&, httplib::Response& res) {
+      res.set_header("Cache-Control", "no-store");
+      res.set_content(body, type);
+    };
+  };
+  impl_->http.Get("/b/scene.json", bytes(i.overlay.json, "application/json"));
+  impl_->http.Get("/b/trace.bin", bytes(i.overlay.blob, "application/octet-stream"));
+  impl_->http.Get("/compare.json", bytes(i.compare, "application/json"));
 }
 
 ViewServer::~ViewServer() = default;

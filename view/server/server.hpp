@@ -23,6 +23,10 @@ class ViewServer {
   ViewServer(const ViewServer&) = delete;
   ViewServer& operator=(const ViewServer&) = delete;
 
+  // Serves a second run beside the first: its scene and blob at /b/scene.json and /b/trace.bin,
+  // and `compare_json` (overlay.hpp) at /compare.json. Before serve().
+  void add_overlay(Packed b, std::string compare_json);
+
   int port() const { return port_; }
   std::string url() const { return "http://127.0.0.1:" + std::to_string(port_) + "/"; }
   // Serves until stop() (from another thread). Returns false if listening failed.

@@ -10,6 +10,12 @@
 //   - each finger's friction circle lies about the recorded surface point with the recorded
 //     radius mu depth;
 //   - a screenshot is not blank: background, floor and the body's colour are counted;
+//   - the time series at the cursor are the trace's at two ticks, a click on a plot seeks; the
+//     friction circle's radius is mu depth; each step button moves one period of its loop; the
+//     view buttons look along the axes; the grasp axis is drawn where the grasp rule holds
+//     (page_checks.mjs);
+//   - two runs overlaid (`graspsim view A B`): B's drawn pose is B's trace, the divergent tick
+//     marked is the one `graspsim compare A B` reports;
 // and that a cut trace is shown up to its last tick with a note, and that bad input (a missing
 // file, a file that is not a trace, a port in use) exits 2 with a message naming it.
 // Exit 0 pass, 1 fail, 77 skipped (chromium cannot start here).
@@ -19,6 +25,7 @@ import { mkdirSync, rmSync, writeFileSync, statSync, existsSync } from 'node:fs'
 import { createServer } from 'node:net';
 import { join } from 'node:path';
 import { decodePng } from './png.mjs';
+import { checkCircleMuDepth, checkGrasp, checkSeries, checkSteps, checkViews } from './page_checks.mjs';
 
 const [cli, src, tmpRoot] = process.argv.slice(2);
 const tmp = join(tmpRoot, 'view_browser');
@@ -59,9 +66,9 @@ function dump(trace) {
 }
 
 // Starts `graspsim view TRACE --port 0` and resolves with { child, url } once it prints the URL.
-function serve(trace, cwd) {
+function serve(trace, cwd, ghost) {
   return new Promise((resolve, reject) => {
-    const child = spawn(cli, ['view', trace, '--port', '0'], { stdio: ['ignore', 'pipe', 'pipe'], cwd });
+    const child = spawn(cli, ['view', trace, ...(ghost ? [ghost] : []), '--port', '0'], { stdio: ['ignore', 'pipe', 'pipe'], cwd });
     let out = '';
     const seen = (d) => {
       out += d;
@@ -113,7 +120,10 @@ function firstChange(trace, finger) {
   return -1;
 }
 
-async function checkScenario(name, scenario) {
+// MU: the friction coefficient of the scenario's finger contacts (its param `mu`); CONTROLS: also
+// check the step and view buttons (the same page code for every trace: one scenario does).
+// Returns the trace as h5py read it.
+async function checkScenario(name, scenario, mu, controls) {
   const file = join(tmp, `${name}.h5`);
   const r = run(['run', join(src, 'scenarios', scenario), '--out', file, '--quiet']);
   if (r.status !== 0) return fail(`${name}: graspsim run exited ${r.status}: ${r.out}`);
@@ -181,6 +191,12 @@ async function checkScenario(name, scenario) {
       }
     }
 
+    const t = { check, hook };
+    await checkSeries(t, page, trace, name);
+    await checkCircleMuDepth(t, page, trace, name, mu);
+    if (controls) await checkSteps(t, page, trace, name, await hook(page, () => window.graspsimView.scene.rates));
+    await checkGrasp(t, page, trace, name);
+
     // Screenshot in the middle of the run: not blank.
     await hook(page, (t) => window.graspsimView.seek(t), pt[n >> 1]);
     await page.waitForTimeout(200);
@@ -202,11 +218,52 @@ async function checkScenario(name, scenario) {
     check(notBackground > 0.2 * total && body > 0.01 * total,
           `${name}: the screenshot (${img.width} x ${img.height}, ${join(tmp, name + '.png')}) is not blank: ` +
           `${(100 * notBackground / total).toFixed(1)}% not background (> 20%), ${(100 * body / total).toFixed(1)}% body-blue (> 1%)`);
+    if (controls) await checkViews(t, page, name);
     check(errors.length === 0, `${name}: no script error in the page${errors.length ? ': ' + errors.join('; ') : ''}`);
     await page.close();
   } finally {
     const code = await stop(child);
     check(code === 0, `${name}: graspsim view stops on SIGINT with exit 0 (got ${code})`);
+  }
+  return trace;
+}
+
+// Two runs overlaid: the lift (A, from checkScenario) and the lift with mu 0.3 (B), where the
+// box slips out of the fingers (2 mu N < m g), so B's box ends below A's.
+// TA: A as h5py read it.
+async function checkOverlay(ta) {
+  if (!ta) return fail('overlay: the lift (A) did not run');
+  const a = join(tmp, 'two_finger_lift.h5'), b = join(tmp, 'slipping.h5');
+  run(['run', join(src, 'scenarios/two_finger_lift.lua'), '--set', 'mu=0.3', '--out', b, '--quiet']);   // its checks fail
+  if (!existsSync(b)) return fail('overlay: the run with mu 0.3 wrote no trace');
+  const compared = run(['compare', a, b, '--json']);
+  const report = JSON.parse(compared.out.slice(compared.out.indexOf('{')));
+  const divergent = report.datasets[0].first.tick;
+  const tb = dump(b);
+  const { child, url } = await serve(a, undefined, b);
+  try {
+    const { page, errors } = await openPage(url);
+    const v = await hook(page, () => ({ tick: window.graspsimView.divergentTick, marker: getComputedStyle(document.getElementById('diverge')).display }));
+    check(v.tick === divergent && v.marker === 'block',
+          `overlay: the timeline marks tick ${v.tick}, the first divergence graspsim compare reports (${divergent}, ${report.datasets[0].path})`);
+    await page.locator('#godiverge').click();
+    check(await hook(page, () => window.graspsimView.tick()) === divergent, 'overlay: the divergence button goes to that tick');
+    const pt = tb.physics_tick, n = pt.length;
+    for (const row of [n >> 1, n - 1]) {
+      await hook(page, (x) => window.graspsimView.seek(x), pt[row]);
+      const ghost = await hook(page, () => window.graspsimView.ghost());
+      let same = true, apart = false;
+      for (const g of ghost) {
+        const rb = tb.bodies[g.name];
+        same &&= g.position.every((x, k) => x === rb.position[row][k]) && g.quaternion.every((x, k) => x === rb.quaternion[row][k]);
+        apart ||= g.position[2] !== ta.bodies[g.name].position[row][2];
+      }
+      check(same && apart, `overlay: at tick ${pt[row]} the ghost is drawn at B's /physics row ${row}, not at A's`);
+    }
+    check(errors.length === 0, `overlay: no script error in the page${errors.length ? ': ' + errors.join('; ') : ''}`);
+    await page.close();
+  } finally {
+    await stop(child);
   }
 }
 
@@ -294,13 +351,23 @@ async function checkBadInput() {
           `port ${taken} served by another graspsim view`);
   await stop(first.child);
   expect2([], /needs a trace file/, 'no trace');
+  const lift = join(tmp, 'two_finger_lift.h5');
+  expect2([lift, join(tmp, 'missing_b.h5')], /missing_b\.h5: no such file/, 'a second trace that is missing');
+  expect2([lift, lift, lift], /at most two traces/, 'three traces');
+  const fast = join(tmp, 'physics_100hz.h5');
+  run(['run', join(src, 'scenarios/two_finger_lift.lua'), '--set', 'rates.physics=100', '--out', fast, '--quiet']);
+  expect2([lift, fast], /cannot compare .* different rates/, 'two traces at different rates');
+  const r = run(['compare', lift, lift, '--view', '--atol', '1']);
+  check(r.status === 2 && /--view marks the first divergence at tolerance 0/.test(r.out),
+        `compare --view with a tolerance: exit ${r.status}, "${r.out.trim().split('\n').pop()}"`);
   const help = run(['view', '--help']);
   check(help.status === 0 && help.out.includes('--port N') && help.out.includes('exit status'), '--help documents the command');
 }
 
 try {
-  await checkScenario('two_finger_lift', 'two_finger_lift.lua');
-  await checkScenario('mesh_grasp', 'mesh_grasp.lua');
+  const lift = await checkScenario('two_finger_lift', 'two_finger_lift.lua', 0.8, true);
+  await checkScenario('mesh_grasp', 'mesh_grasp.lua', 0.8, false);
+  await checkOverlay(lift);
   await checkCut();
   await checkPlaceholder();
   await checkBadInput();

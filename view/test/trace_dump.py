@@ -1,7 +1,8 @@
 #!/usr/bin/python3
 """What the browser test compares the page with, read by h5py (not by graspsim's own reader):
-every /physics row's tick, each body's position and quaternion, and each finger's /haptic tick,
-contact state, surface point and friction radius. Usage: trace_dump.py TRACE.h5 -> JSON on stdout. A cut trace is opened in
+every /physics row's tick, each body's position, quaternion, grasp area and torsion, and each
+finger's /haptic tick, contact state, contacted body, god-object, force, surface point, depth and
+friction radius, and its HIP from the /servo row at each haptic tick. Usage: trace_dump.py TRACE.h5 -> JSON on stdout. A cut trace is opened in
 SWMR mode, as recordings/README.md says h5py must."""
 import json
 import sys
@@ -13,6 +14,9 @@ def main(path):
     with h5py.File(path, "r", swmr=True) as f:
         physics = f["physics"][:]
         haptic = f["haptic"][:]
+        servo = f["servo"][:]
+        servo_row = {int(t): i for i, t in enumerate(servo["tick"])}
+        at_haptic = [servo_row.get(int(t), 0) for t in haptic["tick"]]
         names = physics.dtype.names
         bodies = sorted({n.split("/")[1] for n in names if n.startswith("objects/")})
         fingers = sorted({n.split("/")[1] for n in haptic.dtype.names if n.startswith("fingers/")})
@@ -20,11 +24,18 @@ def main(path):
             "status": f.attrs["status"] if isinstance(f.attrs["status"], str) else f.attrs["status"].decode(),
             "physics_tick": physics["tick"].tolist(),
             "bodies": {b: {"position": physics[f"objects/{b}/position"].tolist(),
-                           "quaternion": physics[f"objects/{b}/quaternion"].tolist()} for b in bodies},
+                           "quaternion": physics[f"objects/{b}/quaternion"].tolist(),
+                           "grasp_area": physics[f"objects/{b}/grasp_area"].tolist(),
+                           "torsion": physics[f"objects/{b}/torsion"].tolist()} for b in bodies},
             "haptic_tick": haptic["tick"].tolist(),
             "fingers": {n: {"state": haptic[f"fingers/{n}/state"].tolist(),
                             "surface_point": haptic[f"fingers/{n}/surface_point"].tolist(),
-                            "friction_radius": haptic[f"fingers/{n}/friction_radius"].tolist()} for n in fingers},
+                            "friction_radius": haptic[f"fingers/{n}/friction_radius"].tolist(),
+                            "depth": haptic[f"fingers/{n}/depth"].tolist(),
+                            "body": haptic[f"fingers/{n}/body"].tolist(),
+                            "god_object": haptic[f"fingers/{n}/god_object"].tolist(),
+                            "force": haptic[f"fingers/{n}/force"].tolist(),
+                            "hip": servo[f"fingers/{n}/hip"][at_haptic].tolist()} for n in fingers},
         }
     json.dump(out, sys.stdout)
 

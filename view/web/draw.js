@@ -29,19 +29,43 @@ function bodyGeometry(shape) {
   }
 }
 
-function makeBody(body) {
+// A body; `ghost`: the second run of an overlay, orange and mostly transparent.
+function makeBody(body, ghost = false) {
   const group = new THREE.Group();
   group.name = body.name;
   let geometry = bodyGeometry(body.shape);
   const known = geometry !== null;
   if (!known) geometry = new THREE.BoxGeometry(0.02, 0.02, 0.02);   // placeholder: shape unknown
   const material = new THREE.MeshStandardMaterial({
-    color: known ? 0x6b8cc7 : 0xbbbbbb, roughness: 0.6, metalness: 0.0,
-    transparent: true, opacity: known ? 0.6 : 0.5, wireframe: !known });
+    color: ghost ? 0xe67e22 : known ? 0x6b8cc7 : 0xbbbbbb, roughness: 0.6, metalness: 0.0,
+    transparent: true, opacity: ghost ? 0.22 : known ? 0.6 : 0.5, wireframe: !known, depthWrite: !ghost });
   group.add(new THREE.Mesh(geometry, material));
   if (known) group.add(new THREE.LineSegments(new THREE.EdgesGeometry(geometry, 20),
-                                              new THREE.LineBasicMaterial({ color: 0x26324a })));
+                                              new THREE.LineBasicMaterial({ color: ghost ? 0xb35400 : 0x26324a,
+                                                                            transparent: ghost, opacity: ghost ? 0.5 : 1 })));
   return group;
+}
+
+// The grasp axis of a body held by two fingers (a line between their god-objects, as the grasp
+// rule takes it) and its torsion: an arc about the axis at its middle, turning the way the
+// torque does (right-hand rule about first -> second finger), drawn while the torsion is not 0.
+const TORSION_ARC = 0.012;   // m: the arc's radius
+function makeGrasp() {
+  const colour = 0x8e44ad;
+  const axis = new THREE.Line(new THREE.BufferGeometry().setFromPoints([new THREE.Vector3(), new THREE.Vector3()]),
+                              new THREE.LineBasicMaterial({ color: colour }));
+  const points = [];
+  for (let k = 0; k <= 48; k++) points.push(new THREE.Vector3(Math.cos(k * Math.PI / 32), Math.sin(k * Math.PI / 32), 0));
+  const arc = new THREE.Group();
+  arc.add(new THREE.Line(new THREE.BufferGeometry().setFromPoints(points), new THREE.LineBasicMaterial({ color: colour })));
+  // Arrowhead at the arc's end (angle 3 pi / 2, point (0, -1, 0), heading +x).
+  const head = new THREE.Mesh(new THREE.ConeGeometry(0.12, 0.3, 12).rotateZ(-Math.PI / 2),
+                              new THREE.MeshBasicMaterial({ color: colour }));
+  head.position.set(0, -1, 0);
+  arc.add(head);
+  arc.scale.setScalar(TORSION_ARC);
+  axis.visible = arc.visible = false;
+  return { axis, arc, held: false, torsion: 0, ends: null };
 }
 
 function makeFinger(finger) {
@@ -83,8 +107,57 @@ export class SceneView {
       this.scene.add(v.go, v.hip, v.spring, v.arrow, v.circle);
       return v;
     });
+    this.grasps = scene.bodies.map(() => { const g = makeGrasp(); this.scene.add(g.axis, g.arc); return g; });
+    this.ghosts = [];
+    this.ghostFingers = [];
     this.resize();
-    window.addEventListener('resize', () => this.resize());
+    // The stage's size follows the window and the timeline's wrapping.
+    new ResizeObserver(() => this.resize()).observe(container);
+  }
+
+  // The second run of an overlay: its bodies ghosted, its god-objects as faint spheres.
+  addGhost(scene) {
+    this.ghosts = scene.bodies.map((b) => { const g = makeBody(b, true); this.scene.add(g); return g; });
+    this.ghostFingers = scene.fingers.map((f) => {
+      const m = new THREE.Mesh(new THREE.SphereGeometry(f.radius > 0 ? f.radius : POINT_PAD, 16, 8),
+                               new THREE.MeshBasicMaterial({ color: 0xe67e22, transparent: true, opacity: 0.35, depthWrite: false }));
+      m.name = f.name;
+      this.scene.add(m);
+      return m;
+    });
+  }
+  setGhostBody(i, p, q) {
+    this.ghosts[i].position.set(p[0], p[1], p[2]);
+    this.ghosts[i].quaternion.set(q[1], q[2], q[3], q[0]);
+  }
+  setGhostFinger(j, go) { this.ghostFingers[j].position.set(go[0], go[1], go[2]); }
+
+  // Body i's grasp: held between god-objects a and b (world, m) with `torsion` (N m), or not
+  // held (a null).
+  setGrasp(i, a, b, torsion) {
+    const g = this.grasps[i];
+    g.held = a !== null;
+    g.axis.visible = g.held;
+    g.arc.visible = g.held && torsion !== 0;
+    g.torsion = g.held ? torsion : 0;
+    g.ends = g.held ? [a, b] : null;
+    if (!g.held) return;
+    const A = new THREE.Vector3(...a), B = new THREE.Vector3(...b);
+    g.axis.geometry.setFromPoints([A, B]);
+    const u = B.clone().sub(A).normalize();
+    g.arc.position.copy(A).add(B).multiplyScalar(0.5);
+    g.arc.quaternion.setFromUnitVectors(new THREE.Vector3(0, 0, 1), torsion >= 0 ? u : u.negate());
+  }
+
+  // The camera along an axis through `target`, as far from it as it is now: 'y' from the front
+  // (-y, looking along +y), 'x' from the side (+x, looking along -x), 'z' from above (looking
+  // down; a hair off the vertical, which the orbit controls keep z up with).
+  lookAlong(axis, target) {
+    const d = this.camera.position.distanceTo(target);
+    const from = { x: [1, 0, 0], y: [0, -1, 0], z: [0, -1e-4, 1] }[axis];
+    const v = new THREE.Vector3(...from).normalize().multiplyScalar(d);
+    this.camera.position.copy(target).add(v);
+    this.camera.lookAt(target);
   }
 
   addFloor(height) {
