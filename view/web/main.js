@@ -31,10 +31,9 @@ const slice = (a, row, w) => Array.from(a.subarray(row * w, row * w + w));
 
 async function start() {
   const t0 = performance.now();
-  const [scene, buffer] = await Promise.all([
-    fetch('scene.json').then((r) => { if (!r.ok) throw new Error(`scene.json: HTTP ${r.status}`); return r.json(); }),
-    fetch('trace.bin').then((r) => { if (!r.ok) throw new Error(`trace.bin: HTTP ${r.status}`); return r.arrayBuffer(); }),
-  ]);
+  const scene = await fetch('scene.json').then((r) => { if (!r.ok) throw new Error(`scene.json: HTTP ${r.status}`); return r.json(); });
+  if (scene.live) { (await import('./live.js')).startLive(scene); return; }   // a running scenario (live.js)
+  const buffer = await fetch('trace.bin').then((r) => { if (!r.ok) throw new Error(`trace.bin: HTTP ${r.status}`); return r.arrayBuffer(); });
   const col = columns(scene, buffer);
   const physicsTicks = col.physics_tick, hapticTicks = col.haptic_tick;
   const rate = scene.rates.servo;
