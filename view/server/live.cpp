@@ -90,7 +90,7 @@ struct LiveServer::Impl {
   std::string end_message;          // set once the run is over
   bool pump_done = false;           // the pump returns (the run is over)
   bool stopping = false;            // the pump and every stream return
-  int streams = 0, ended_streams = 0;
+  int unended = 0;                  // open /live streams that have not sent the end yet
 
   explicit Impl(app::LiveChannel& c) : channel(c) {}
 
@@ -117,8 +117,14 @@ struct LiveServer::Impl {
     }
   }
 
+  struct Stream {
+    std::uint64_t sent = 0;   // the sequence of the last message sent
+    bool ended = false;       // the end was sent
+  };
+
   // One /live stream: the newest message whenever there is one it has not sent, then the end.
-  bool stream(httplib::DataSink& sink, std::uint64_t& sent) {
+  bool stream(httplib::DataSink& sink, Stream& st) {
+    std::uint64_t& sent = st.sent;
     std::unique_lock<std::mutex> lock(mutex);
     changed.wait_for(lock, std::chrono::milliseconds(100),
                      [&] { return sequence != sent || !end_message.empty() || stopping; });
@@ -138,7 +144,8 @@ struct LiveServer::Impl {
       const bool ok = sink.write(m.data(), m.size());
       if (ok) sink.done();
       lock.lock();
-      ++ended_streams;
+      st.ended = true;
+      --unended;
       changed.notify_all();
       return ok;
     }
@@ -159,15 +166,15 @@ LiveServer::LiveServer(const scripting::Scenario& scenario, app::LiveChannel& ch
     res.set_header("Cache-Control", "no-store");
     {
       std::lock_guard<std::mutex> lock(im.mutex);
-      ++im.streams;
+      ++im.unended;
     }
-    auto sent = std::make_shared<std::uint64_t>(0);
+    auto st = std::make_shared<Impl::Stream>();
     // text/event-stream is not one httplib compresses, so every message leaves as it is made.
     res.set_chunked_content_provider(
-        "text/event-stream", [&im, sent](std::size_t, httplib::DataSink& sink) { return im.stream(sink, *sent); },
-        [&im](bool) {
+        "text/event-stream", [&im, st](std::size_t, httplib::DataSink& sink) { return im.stream(sink, *st); },
+        [&im, st](bool) {   // the stream is over (ended, or the page went)
           std::lock_guard<std::mutex> lock(im.mutex);
-          --im.streams;
+          if (!st->ended) --im.unended;
           im.changed.notify_all();
         });
   });
@@ -211,7 +218,7 @@ void LiveServer::end(const LiveEnd& end, double wait_s) {
   std::unique_lock<std::mutex> lock(im.mutex);
   im.end_message = "event: end\ndata: {\"status\":" + json_string(end.status) + ",\"trace\":" + json_string(end.trace) + "}\n\n";
   im.changed.notify_all();
-  im.changed.wait_for(lock, std::chrono::duration<double>(wait_s), [&] { return im.ended_streams >= im.streams; });
+  im.changed.wait_for(lock, std::chrono::duration<double>(wait_s), [&] { return im.unended == 0; });
 }
 
 LiveServer::~LiveServer() {
