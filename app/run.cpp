@@ -41,6 +41,7 @@ RunResult run_scenario(const scripting::Scenario& scenario, const RunOptions& op
       run.feed_script(n);
       run.check_interrupt(n);
       run.report_progress(n);
+      run.publish_live(n);
     }
     run.after_last_tick();
   } catch (const std::bad_alloc&) {

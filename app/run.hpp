@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "app/live_channel.hpp"
 #include "app/output_file.hpp"
 #include "app/pacer.hpp"
 #include "graspsim/hw/device.hpp"
@@ -73,6 +74,13 @@ struct RunOptions {
     Pacer* pacer = nullptr;
     bool realtime = false;
   } pacing;
+
+  // The live view (live_channel.hpp): when set, after every tick that ran the haptic or the
+  // physics loop the loop copies the bodies' poses and the fingers' HIP, god-object, force and
+  // contact into the channel's preallocated snapshot and publishes it (no lock, no allocation;
+  // the trace is the same with or without it). Sized for the scenario's model: a channel of
+  // other sizes ends the run before its first tick, with an error saying so.
+  LiveChannel* live = nullptr;
 
   // When the run stops before the scenario's end.
   struct Stop {

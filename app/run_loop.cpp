@@ -85,6 +85,10 @@ void Run::open_devices() {
 }
 
 void Run::prepare() {
+  if (options_.live && (options_.live->bodies() != model_.bodies.size() || options_.live->fingers() != model_.fingers.size()))
+    throw std::invalid_argument("the live view's snapshots are sized for " + std::to_string(options_.live->bodies()) +
+                                " bodies and " + std::to_string(options_.live->fingers()) + " fingers; the scenario has " +
+                                std::to_string(model_.bodies.size()) + " and " + std::to_string(model_.fingers.size()));
   Simulation& sim = sim_.emplace(model_);
   trace_.open_tables(model_, options_.trace.block_rows, start_);
   const std::int64_t device_every = options_.trace.record.of(recordings::RecordedLoop::kDevices);
@@ -223,6 +227,33 @@ void Run::report_progress(std::int64_t n) {
     last_progress_ = RunClock::now();
     options_.report.progress(sim_->time(), scenario_.duration());
   }
+}
+
+void Run::publish_live(std::int64_t n) {
+  LiveChannel* live = options_.live;
+  if (!live || !(record_.haptic_ran || record_.physics_ran)) return;
+  if (record_.physics_ran) live_physics_tick_ = n;
+  if (record_.haptic_ran) live_haptic_tick_ = n;
+  // Copies into the snapshot's preallocated vectors: element assignments, nothing allocated.
+  LiveSnapshot& s = live->back();
+  s.tick = n;
+  s.physics_tick = live_physics_tick_;
+  s.haptic_tick = live_haptic_tick_;
+  for (std::size_t i = 0; i < s.bodies.size(); ++i) {
+    s.bodies[i].position = record_.physics[i].position;
+    s.bodies[i].orientation = record_.physics[i].orientation;
+  }
+  for (std::size_t f = 0; f < s.fingers.size(); ++f) {
+    const HapticFingerRecord& h = record_.haptic[f];
+    LiveFinger& out = s.fingers[f];
+    out.hip = record_.servo[f].hip;
+    out.god_object = h.god_object;
+    out.force = h.force;
+    out.surface_point = h.surface_point;
+    out.friction_radius = h.friction_radius;
+    out.state = static_cast<std::int8_t>(h.phase);
+  }
+  live->publish();
 }
 
 void Run::after_last_tick() {

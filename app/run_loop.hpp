@@ -49,6 +49,7 @@ class Run {
   void feed_script(std::int64_t n);       // views for Lua trajectories, tick done
   void check_interrupt(std::int64_t n);   // throws when interrupted
   void report_progress(std::int64_t n);
+  void publish_live(std::int64_t n);      // the live view's snapshot, after a haptic or physics tick
 
   // After the loop.
   void after_last_tick();          // a run of no tick: its initial state; the expectations due at the end
@@ -96,6 +97,7 @@ class Run {
   // The read-only view trajectory functions get: the state as the last physics tick left it.
   bool view_ = false;
   scripting::Snapshot view_state_;
+  std::int64_t live_physics_tick_ = -1, live_haptic_tick_ = -1;   // servo ticks the live snapshot's parts are from
   bool realtime_ = false;          // this thread is SCHED_FIFO (until stop())
   bool started_ = false;           // every device was built: the run goes on to its first tick
 };

@@ -20,6 +20,7 @@
 #include "app/sweep_row.hpp"
 #include "cli/repair.hpp"
 #include "cli/replay.hpp"
+#include "cli/live.hpp"
 #include "cli/sweep.hpp"
 #include "cli/view.hpp"
 #include "cli/report.hpp"
@@ -40,7 +41,8 @@ using graspsim::cli::kExitTraceFault;
 constexpr const char* kUsage =
     "usage: graspsim run SCENARIO.lua [--out FILE.h5] [--duration S] [--set NAME=VALUE]...\n"
     "                [--device FINGER=SPEC]... [--jitter A [--jitter-seed N]] [--refuse-unstable]\n"
-    "                [--no-trace | --record LOOP[:EVERY],...] [--summary FILE]\n"
+    "                [--no-trace | --record LOOP[:EVERY],...] [--summary FILE] [--pace]\n"
+    "                [--view [--port N] [--open] | --no-view]\n"
     "       graspsim sweep SCENARIO.lua --grid NAME=V1,V2,... [--grid ...] [--seeds N] [--jobs N]\n"
     "                --out DIR [--keep-traces] [--slurm] [--resume]\n"
     "       graspsim replay TRACE.h5 [--out NEW.h5] [--set NAME=VALUE]...\n"
@@ -93,6 +95,17 @@ constexpr const char* kHelp =
     "  --refuse-unstable    stop the run at the first unstable mode the stability check\n"
     "                       finds (as the scenario field stability = \"refuse\"), exit 2;\n"
     "                       without it each one is a warning on stderr, with its time\n"
+    "  --pace               pace the run in real time at the servo rate, as a udp or phantom\n"
+    "                       device does, with simulated devices too (a rehearsal of a session:\n"
+    "                       the same deadlines, stall and lag limits and overrun counts)\n"
+    "  --view               serve a live 3D view of the run on 127.0.0.1 while it goes (the\n"
+    "                       page of `graspsim view`, fed about 60 times a second; the run never\n"
+    "                       waits for it, the trace is the same); prints its URL. On by default\n"
+    "                       in a paced run (a hand on a device), where the default port being\n"
+    "                       taken means any free one\n"
+    "  --port N             the live view's port (default 8717; 0: any free port)\n"
+    "  --open               open the live view with xdg-open as well\n"
+    "  --no-view            no live view in a paced run\n"
     "  --quiet              print only errors and failed expectations\n"
     "  --summary FILE       also write each expectation checked as a line of FILE,\n"
     "                       PASS|FAIL<tab>what<tab>measured (tab, newline, backslash as \\t \\n \\\\;\n"
@@ -260,7 +273,8 @@ int run_command(const std::vector<std::string>& args) {
   std::optional<graspsim::recordings::RecordSelection> record;
   std::vector<std::string> device_options;
   std::string summary;   // --summary FILE: the expectations, one line each
-  bool jitter_seed_given = false;
+  bool jitter_seed_given = false, pace = false;
+  graspsim::cli::LiveOptions live;
   for (std::size_t i = 0; i < args.size(); ++i) {
     const std::string& a = args[i];
     const auto value = [&]() -> const std::string* {
@@ -330,6 +344,10 @@ int run_command(const std::vector<std::string>& args) {
       summary = *v;
     } else if (a == "--refuse-unstable") {
       refuse_unstable = true;
+    } else if (a == "--pace") {
+      pace = true;
+    } else if (std::string error; graspsim::cli::parse_live_option(args, i, live, error)) {
+      if (!error.empty()) return bad_input(error);
     } else if (a.rfind("-", 0) == 0) {
       return bad_input("unknown option '" + a + "'\n" + kUsage);
     } else if (scenario_path.empty()) {
@@ -379,7 +397,7 @@ int run_command(const std::vector<std::string>& args) {
   // A hand on a real device: pace the loop in real time on a SCHED_FIFO thread if allowed.
   graspsim::app::SteadyClock steady;
   std::optional<graspsim::app::Pacer> pacer;
-  if (plan.any_real()) {
+  if (plan.any_real() || pace) {
     pacer.emplace(steady, scenario->model().rates.servo, graspsim::app::kStallTimeout);
     options.pacing.pacer = &*pacer;
     const std::string why = graspsim::app::probe_realtime();
@@ -427,6 +445,12 @@ int run_command(const std::vector<std::string>& args) {
   if (!too_big.empty()) return bad_input(too_big);
   if (!size_warning.empty()) std::cerr << "graspsim: warning: " << size_warning << "\n";
 
+  // The live view, asked for or of a paced run: started last, so that nothing above waits for it.
+  if (const std::string e = graspsim::cli::check_live_options(live, pacer.has_value()); !e.empty()) return bad_input(e);
+  graspsim::cli::LiveSession live_view;
+  if (const std::string e = live_view.start(*scenario, live, pacer.has_value(), options); !e.empty())
+    return bad_input(e);
+
   graspsim::app::RunResult result;
   try {
     result = graspsim::app::run_scenario(*scenario, options);
@@ -435,6 +459,7 @@ int run_command(const std::vector<std::string>& args) {
   } catch (const graspsim::recordings::TraceError& e) {
     return bad_input(std::string("cannot write the trace: ") + e.what());
   }
+  live_view.end(result, no_trace || result.not_started ? "" : result.trace_path);
   if (tty) std::fprintf(stderr, "\r%60s\r", "");
   if (result.not_started) {
     return bad_input("the run could not start: " + result.error +

@@ -130,7 +130,7 @@ Packed pack_scene(const ViewScene& s) {
     fingers += std::string(j ? ",\n    " : "") + "{\"name\": " + json_string(f.name) + ", \"radius\": " + number(f.radius) + "}";
   }
   Packed out;
-  out.json = "{\n  \"trace\": " + json_string(s.trace) + ",\n  \"scenario\": " + json_string(s.scenario_name) +
+  out.json = "{\n  \"live\": " + std::string(s.live ? "true" : "false") + ",\n  \"trace\": " + json_string(s.trace) + ",\n  \"scenario\": " + json_string(s.scenario_name) +
              ",\n  \"status\": " + json_string(s.status) + ",\n  \"note\": " + json_string(s.note) +
              ",\n  \"rates\": {\"servo\": " + std::to_string(s.rate_servo) + ", \"haptic\": " +
              std::to_string(s.rate_haptic) + ", \"physics\": " + std::to_string(s.rate_physics) +

@@ -47,6 +47,7 @@ struct FingerView {
 };
 
 struct ViewScene {
+  bool live = false;              // a running scenario (live.hpp): no rows, the page streams them
   std::string trace;              // the file as given
   std::string scenario_name;
   std::string status;             // root `status`

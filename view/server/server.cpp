@@ -12,7 +12,7 @@ std::string web_folder() {
   const char* env = std::getenv("GRASPSIM_VIEW_WEB");
   const std::string dir = env && *env ? env : GRASPSIM_VIEW_WEB_DIR;
   namespace fs = std::filesystem;
-  for (const char* file : {"index.html", "main.js", "draw.js", "three/three.module.js", "three/OrbitControls.js"}) {
+  for (const char* file : {"index.html", "main.js", "draw.js", "live.js", "three/three.module.js", "three/OrbitControls.js"}) {
     if (!fs::is_regular_file(fs::path(dir) / file))
       throw ViewError("the page's files are missing: no " + (fs::path(dir) / file).string() +
                       " (run ./tools/graspsim once: it runs `npm ci` in view/web and builds the page)");

@@ -1,8 +1,9 @@
-# Copies the page into OUT: index.html and its modules (main.js, draw.js, series.js, plots.js), and from node_modules/three the module build
-# (three.module.js imports three.core.js) and OrbitControls. copy_if_different keeps it cheap.
+# Copies the page into OUT: index.html and its modules (main.js, draw.js, series.js, plots.js,
+# live.js), and from node_modules/three the module build (three.module.js imports three.core.js)
+# and OrbitControls. copy_if_different keeps it cheap.
 # Usage: cmake -DWEB=<view/web> -DOUT=<build>/view/web -P copy_web.cmake
 file(MAKE_DIRECTORY ${OUT}/three)
-foreach(f index.html main.js draw.js series.js plots.js)
+foreach(f index.html main.js draw.js series.js plots.js live.js)
   file(COPY_FILE ${WEB}/${f} ${OUT}/${f} ONLY_IF_DIFFERENT)
 endforeach()
 set(three ${WEB}/node_modules/three)

@@ -66,7 +66,11 @@ function panels(a, sa, b, sb) {
 
 async function start() {
   const t0 = performance.now();
-  const [a, b] = await Promise.all([loadRun('', false), loadRun('b/', true)]);
+  const first_scene = await getJson('scene.json', false);
+  if (first_scene.live) { (await import('./live.js')).startLive(first_scene); return; }   // a running scenario (live.js)
+  const [a, b] = await Promise.all([
+    getBlob('trace.bin').then((buffer) => ({ scene: first_scene, col: columns(first_scene, buffer) })),
+    loadRun('b/', true)]);
   const compare = b ? await getJson('compare.json') : null;
   const { scene, col } = a;
   const physicsTicks = col.physics_tick, hapticTicks = col.haptic_tick;
