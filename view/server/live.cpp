@@ -41,8 +41,17 @@ ViewScene live_scene(const scripting::Scenario& scenario) {
   s.duration = scenario.duration();
   s.floor = m.floor.enabled;
   s.floor_height = m.floor.height;
-  for (const BodyParams& b : m.bodies) s.bodies.push_back({b.name, true, b.shape, {}, {}});
-  for (const FingerParams& f : m.fingers) s.fingers.push_back({f.name, f.radius, {}, {}, {}, {}, {}, {}});
+  for (const BodyParams& b : m.bodies) {   // the shapes only: the poses come over /live
+    BodyView& v = s.bodies.emplace_back();
+    v.name = b.name;
+    v.shape_known = true;
+    v.shape = b.shape;
+  }
+  for (const FingerParams& f : m.fingers) {
+    FingerView& v = s.fingers.emplace_back();
+    v.name = f.name;
+    v.radius = f.radius;
+  }
   return s;
 }
 
