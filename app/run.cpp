@@ -103,7 +103,7 @@ const RunResult& RunSession::finish() {
   finished_ = true;
   if (!stopped_) {
     try {
-      run_->after_last_tick();
+      run_->after_last_tick(next_);
     } catch (...) {
       run_->fail(failure(result_.servo_ticks));
     }

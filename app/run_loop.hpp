@@ -51,7 +51,9 @@ class Run {
   void report_progress(std::int64_t n);
 
   // After the loop.
-  void after_last_tick();          // a run of no tick: its initial state; the expectations due at the end
+  // After servo tick n - 1, the last one run (n = ticks() unless the stepping program stopped
+  // sooner): a run of no tick: its initial state; the expectations due at tick n.
+  void after_last_tick(std::int64_t n);
   void fail(const std::string& error) { result_.error = error; }
   void stop();                     // release every device, leave real time, deferred checks
   bool started() const { return started_; }

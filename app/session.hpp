@@ -44,7 +44,10 @@ class RunSession {
   const Input& input() const;         // the last tick's device inputs (HIP, gimbal per finger)
 
   // Checks the expectations due at the end (if every tick ran without error), releases every
-  // device, finishes the trace. Idempotent: later calls return the same result.
+  // device, finishes the trace. Called before the last tick, it ends the run there, as a run of
+  // RunOptions::Stop::max_ticks would: the expectations due at this tick are checked, later ones
+  // are reported as not checked, and the trace holds the ticks run. Idempotent: later calls
+  // return the same result.
   const RunResult& finish();
   bool finished() const { return finished_; }
 

@@ -23,6 +23,9 @@ graspsim_packages=(
                                     # sanitizer build (its runtimes) and libFuzzer (README.md
                                     # "Sanitizers and fuzzing")
   libcpp-httplib-dev                # `graspsim view`'s HTTP server (view/README.md)
+  pybind11-dev python3-dev python3-numpy python3-pytest
+                                    # the Python module and its tests (python/README.md), for
+                                    # Debian's /usr/bin/python3
   chromium                          # the browser test of `graspsim view` (view/test), headless
 )
 # The page's packages come from the npm registry (view/web/package-lock.json): Node and npm,
