@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 import graspsim
-from conftest import LIFT
+from conftest import LIFT, cli
 
 FLOOR = os.path.join(os.path.dirname(__file__), "finger_on_floor.lua")
 K = 400.0    # N/m: the finger's stiffness (the rigid floor adds no spring in series)
@@ -67,3 +67,17 @@ def test_only_driven_fingers_take_a_hip():
         d.set_hip("thumb", [0, float("nan"), 0])
     with pytest.raises(ValueError, match="three numbers"):
         d.set_hip("thumb", [0, 0])
+
+
+def test_a_python_driven_session_replays_bit_for_bit(tmp_path):
+    # A driven finger's samples go to /devices/<finger>, so `graspsim replay` feeds them back and
+    # must reproduce the session (it compares the new trace with the recording, exit 0 if equal).
+    s = graspsim.load(LIFT, trace=tmp_path / "driven.h5", drive=["thumb"])
+    s.step(3600)                                          # t = 1.2 s: gripping
+    s.set_hip("thumb", s.hip("thumb") + [0.002, 0, 0])    # 2 mm deeper into the box
+    s.step(300)
+    s.follow_trajectory("thumb")
+    assert s.run()["error"] == ""
+    assert graspsim.trace_attribute(tmp_path / "driven.h5", "devices").startswith("thumb: program")
+    p = cli("replay", tmp_path / "driven.h5", "--out", tmp_path / "replay.h5")
+    assert p.returncode == 0 and "bit for bit" in p.stdout, p.stdout + p.stderr
