@@ -81,6 +81,13 @@ Session::Session(const LoadArgs& args) : scenario_(load_scenario(args)), registr
   const std::string too_big = app::check_run_fits(scenario_, options_, &warning);
   if (!too_big.empty()) throw std::invalid_argument(too_big);
   run_ = std::make_unique<app::RunSession>(scenario_, options_);
+  // A device that could not be built (or a run that could not be prepared): nothing was
+  // written, as `graspsim run` exits 2 with "the run could not start".
+  if (!run_->error().empty()) {
+    const std::string error = run_->finish().error;
+    throw app::DeviceError("the run could not start: " + error +
+                           " (nothing was written; a file already at the trace's path is as it was)");
+  }
 }
 
 std::size_t Session::finger(const std::string& name) const {

@@ -36,7 +36,8 @@ struct LoadArgs {
 
 class Session {
  public:
-  // Throws scripting::ScenarioError (file and line, or the field), app::DeviceError,
+  // Throws scripting::ScenarioError (file and line, or the field), app::DeviceError (a bad
+  // device spec, or a device that cannot be built: nothing written),
   // std::invalid_argument (an argument of load(), named), app::OutputError or
   // recordings::TraceError (the trace cannot be written; nothing is).
   explicit Session(const LoadArgs& args);

@@ -70,3 +70,20 @@ def test_a_file_that_is_not_a_trace_is_named(tmp_path):
     junk.write_text("not HDF5")
     with pytest.raises(graspsim.TraceError, match="junk.h5"):
         graspsim.read_trace(junk)
+
+
+def test_a_device_that_cannot_open_writes_nothing(tmp_path):
+    # The thumb's default device replays a file that is not a trace: the run cannot start, and
+    # the file already at the trace's path is left as it was (as `graspsim run` exits 2).
+    junk = tmp_path / "junk.h5"
+    junk.write_text("not HDF5")
+    source = open(LIFT).read().replace(
+        "trajectory = path(-1) }", "trajectory = path(-1), device = { default = \"replay:%s\" } }" % junk)
+    assert "replay:" in source
+    scenario = tmp_path / "device.lua"
+    scenario.write_text(source)
+    out = tmp_path / "out.h5"
+    out.write_text("kept")
+    with pytest.raises(graspsim.DeviceError, match="could not start.*junk.h5"):
+        graspsim.load(scenario, trace=out)
+    assert out.read_text() == "kept" and not os.path.exists(str(out) + ".partial")
