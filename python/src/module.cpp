@@ -10,6 +10,7 @@
 #include <stdexcept>
 
 #include "app/output_file.hpp"
+#include "graspsim/engine/math.hpp"
 #include "graspsim/recordings/trace_reader.hpp"
 #include "graspsim/recordings/trace_writer.hpp"
 #include "session.hpp"
@@ -173,6 +174,11 @@ py::dict state_dict(const Session& s) {
   py::dict bodies;
   bodies["position"] = vec3s(nb, [&](std::size_t b) { return st.bodies[b].position; });
   bodies["rotation"] = rotation;
+  // w, x, y, z with w >= 0: the engine's own conversion, as the trace's orientation column.
+  bodies["orientation"] = rows(nb, 4, [&](std::size_t b, double* out) {
+    const graspsim::Quat q = graspsim::quat_of(st.bodies[b].rotation);
+    out[0] = q.w(), out[1] = q.x(), out[2] = q.y(), out[3] = q.z();
+  });
   bodies["velocity"] = vec3s(nb, [&](std::size_t b) { return st.bodies[b].velocity; });
   bodies["angular_velocity"] = vec3s(nb, [&](std::size_t b) { return st.bodies[b].angular_velocity; });
   bodies["asleep"] = scalars<bool>(nb, [&](std::size_t b) { return st.bodies[b].asleep; });

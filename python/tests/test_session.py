@@ -58,6 +58,9 @@ def test_records_and_state_agree_with_the_trace(tmp_path):
     st = s.state()
     assert st["bodies"]["position"].shape == (1, 3) and st["bodies"]["rotation"].shape == (1, 3, 3)
     assert np.allclose(st["bodies"]["rotation"][0] @ st["bodies"]["rotation"][0].T, np.eye(3))
+    # A physics tick records the state before its step, so the state now is that record only
+    # where the box did not move: its orientation (the grip holds it level to round-off).
+    assert np.allclose(st["bodies"]["orientation"][0], rec["physics"]["orientation"][0], atol=1e-9)
     s.finish()
     t = graspsim.read_trace(tmp_path / "t.h5")
     row = int(np.flatnonzero(t["/physics/tick"] == 3000)[0])
