@@ -256,9 +256,9 @@ void Run::publish_live(std::int64_t n) {
   live->publish();
 }
 
-void Run::after_last_tick() {
-  if (run_ticks_ == 0) expectations_->capture_initial(*sim_, record_, slip_);
-  expectations_->at_tick(run_ticks_, *sim_, record_, slip_);
+void Run::after_last_tick(std::int64_t n) {
+  if (n == 0) expectations_->capture_initial(*sim_, record_, slip_);
+  expectations_->at_tick(n, *sim_, record_, slip_);
 }
 
 void Run::release_all() {

@@ -1,5 +1,5 @@
-// The stages of one run, each a member of Run, which holds what they share. run_scenario
-// (run.cpp) calls them in order and is the table of contents; this header is for run.cpp and
+// The stages of one run, each a member of Run, which holds what they share. RunSession (run.cpp,
+// session.hpp) calls them in order and is the table of contents; this header is for run.cpp and
 // run_loop.cpp only.
 #pragma once
 
@@ -52,10 +52,16 @@ class Run {
   void publish_live(std::int64_t n);      // the live view's snapshot, after a haptic or physics tick
 
   // After the loop.
-  void after_last_tick();          // a run of no tick: its initial state; the expectations due at the end
+  // After servo tick n - 1, the last one run (n = ticks() unless the stepping program stopped
+  // sooner): a run of no tick: its initial state; the expectations due at tick n.
+  void after_last_tick(std::int64_t n);
   void fail(const std::string& error) { result_.error = error; }
   void stop();                     // release every device, leave real time, deferred checks
   bool started() const { return started_; }
+  // What a stepping program reads between ticks (RunSession): null before prepare().
+  const Simulation* simulation() const { return sim_ ? &*sim_ : nullptr; }
+  const TickRecord& tick_record() const { return record_; }
+  const Input& input() const { return input_; }
   std::string warnings() const { return stability_.text(); }
 
  private:

@@ -23,6 +23,9 @@ graspsim_packages=(
                                     # sanitizer build (its runtimes) and libFuzzer (README.md
                                     # "Sanitizers and fuzzing")
   libcpp-httplib-dev                # `graspsim view`'s HTTP server (view/README.md)
+  pybind11-dev python3-dev python3-numpy python3-pytest
+                                    # the Python module and its tests (python/README.md), for
+                                    # Debian's /usr/bin/python3
   chromium                          # the browser test of `graspsim view` (view/test), headless
   slurm-wlm munge                   # `graspsim sweep --slurm`'s test starts a one-node Slurm on
                                     # localhost (tests/sweep/slurm_localhost.sh)
