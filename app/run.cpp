@@ -39,8 +39,7 @@ std::string failure(std::int64_t servo_ticks) {
 // The run, stage by stage (app/README.md): each stage is a member of Run (run_loop.cpp). The
 // constructor holds what comes before the loop, step() the order of every tick, which the
 // goldens pin, and finish() what comes after.
-RunSession::RunSession(const scripting::Scenario& scenario, const RunOptions& options, const RunSeams& seams)
-    : scenario_(scenario) {
+RunSession::RunSession(const scripting::Scenario& scenario, const RunOptions& options, const RunSeams& seams) {
   // Claims the output, opens the trace: throws before anything is written.
   trace_ = std::make_unique<RunTrace>(scenario, options);
   run_ = std::make_unique<Run>(scenario, options, seams, *trace_, result_);

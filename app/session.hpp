@@ -52,7 +52,6 @@ class RunSession {
   bool finished() const { return finished_; }
 
  private:
-  const scripting::Scenario& scenario_;
   RunResult result_;
   std::unique_ptr<RunTrace> trace_;
   std::unique_ptr<Run> run_;
