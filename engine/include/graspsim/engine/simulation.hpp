@@ -40,7 +40,7 @@ class Simulation {
   //   5 tick += 1
   // Time is tick / servo, computed, never accumulated.
   // Inline: at 50 Hz, 59 of 60 ticks run no loop but the servo's, and in a scene without fingers
-  // they run nothing at all; the call was a third of such a tick.
+  // they run nothing at all, so a call would be a third of such a tick's cost.
   void step(const Input& input, TickRecord& record) {
     // The loops that run this tick, in locals: the stages write through `record`, so its fields
     // would be read back after every call.
