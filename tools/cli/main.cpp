@@ -101,8 +101,8 @@ constexpr const char* kHelp =
     "  --view               serve a live 3D view of the run on 127.0.0.1 while it goes (the\n"
     "                       page of `graspsim view`, fed about 60 times a second; the run never\n"
     "                       waits for it, the trace is the same); prints its URL. On by default\n"
-    "                       in a paced run (a hand on a device), where the default port being\n"
-    "                       taken means any free one\n"
+    "                       in a paced run (a hand on a device) started from a terminal, where\n"
+    "                       the default port being taken means any free one\n"
     "  --port N             the live view's port (default 8717; 0: any free port)\n"
     "  --open               open the live view with xdg-open as well\n"
     "  --no-view            no live view in a paced run\n"
@@ -445,10 +445,13 @@ int run_command(const std::vector<std::string>& args) {
   if (!too_big.empty()) return bad_input(too_big);
   if (!size_warning.empty()) std::cerr << "graspsim: warning: " << size_warning << "\n";
 
-  // The live view, asked for or of a paced run: started last, so that nothing above waits for it.
-  if (const std::string e = graspsim::cli::check_live_options(live, pacer.has_value()); !e.empty()) return bad_input(e);
+  // The live view, asked for, or of a paced run started from a terminal (a person at a device;
+  // a script or a test that paces a run gets none unless it asks): started last, so that nothing
+  // above waits for it.
+  const bool view_by_default = pacer.has_value() && isatty(STDOUT_FILENO) == 1;
+  if (const std::string e = graspsim::cli::check_live_options(live, view_by_default); !e.empty()) return bad_input(e);
   graspsim::cli::LiveSession live_view;
-  if (const std::string e = live_view.start(*scenario, live, pacer.has_value(), options); !e.empty())
+  if (const std::string e = live_view.start(*scenario, live, view_by_default, options); !e.empty())
     return bad_input(e);
 
   graspsim::app::RunResult result;
