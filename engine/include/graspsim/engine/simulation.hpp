@@ -74,10 +74,11 @@ class Simulation {
   // The physics stage's parts.
   double gimbal_pitch_change(const Input& input);
   void wake_touched_bodies();
-  void paper_contacts();
+  void paper_contacts(TickRecord& record);
   void paper_body_step(int b, double pitch_change, TickRecord& record);
   void implicit_contacts(const Input& input);
   void implicit_solve(double pitch_change);
+  void record_implicit_contacts(TickRecord& record) const;
   void implicit_body_step(int b, TickRecord& record);
   void record_sleeping(int b, TickRecord& record);
   BodyRecord& record_state(int b, int floor_contacts, TickRecord& record);
