@@ -243,6 +243,7 @@ TEST_CASE("a step with body-body contact allocates no heap memory", "[schedule][
   m.bodies.push_back(graspsim::test::make_box("falling", 0.1, Vec3(0.02, 0.02, 0.02), Vec3(0.01, 0.0, 0.09),
                                               Material{0.5, 1000.0, 5.0}));
   Simulation sim(m);
+  sim.record_contacts(true);   // and the contact points listed for a trace
   Input input = make_input(m);
   TickRecord record = make_tick_record(m);
   for (int n = 0; n < 10; ++n) sim.step(input, record);

@@ -73,7 +73,8 @@ struct TickRecord {
   std::vector<ServoFingerRecord> servo;     // per finger, every tick
   std::vector<HapticFingerRecord> haptic;   // per finger, valid when haptic_ran
   std::vector<BodyRecord> physics;          // per body, valid when physics_ran
-  std::vector<ContactRecord> contacts;      // valid when physics_ran: the contact points of the
+  std::vector<ContactRecord> contacts;      // valid when physics_ran, filled only when the
+                                            // Simulation records contacts (record_contacts): the contact points of the
                                             // awake bodies in the step's order (the count of
                                             // each kind per body is BodyRecord's), cleared and
                                             // refilled each physics step: no allocation once

@@ -63,6 +63,11 @@ class Simulation {
   const Model& model() const { return model_; }
   const State& state() const { return state_; }
   const Divisors& divisors() const { return divisors_; }
+  // Whether the physics stage lists its contact points in TickRecord::contacts (off: the list
+  // stays empty, and the step skips the copies, 2 to 3 % of a resting box's step). Off by
+  // default; the run loop turns it on when a trace records /contacts. Changes no result.
+  void record_contacts(bool on) { record_contacts_ = on; }
+  bool records_contacts() const { return record_contacts_; }
   std::int64_t tick() const { return state_.tick; }
   double time() const { return static_cast<double>(state_.tick) / model_.rates.servo; }   // s
 
@@ -88,6 +93,7 @@ class Simulation {
   void finish_body_step(int b, TickRecord& record);
 
   Model model_;
+  bool record_contacts_ = false;
   Divisors divisors_;
   State state_;
   // Servo ticks until the haptic and the physics loops next run (0: at this tick): the clock's
