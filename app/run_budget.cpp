@@ -51,6 +51,14 @@ RunFootprint estimate_footprint(const scripting::Scenario& scenario, const RunOp
   table("/servo", rows.servo, 1.0, RecordedLoop::kServo);
   table("/haptic", rows.haptic, static_cast<double>(d.haptic), RecordedLoop::kHaptic);
   table("/physics", rows.physics, static_cast<double>(d.physics), RecordedLoop::kPhysics);
+  // /contacts: rows per physics tick vary; counted as four per body (a box resting on its corners).
+  if (options.trace.write && options.trace.record.records(RecordedLoop::kContacts)) {
+    const double every = static_cast<double>(options.trace.record.of(RecordedLoop::kContacts));
+    const double per_tick = 4.0 * static_cast<double>(model.bodies.size());
+    out.tables.push_back({"/contacts", rows.contacts.values, rows.contacts.bytes,
+                          static_cast<double>(options.trace.block_rows > 0 ? options.trace.block_rows : recordings::TraceOptions{}.block_rows),
+                          std::ceil(run / (static_cast<double>(d.physics) * every)) * per_tick});
+  }
   for (std::size_t f = 0; f < options.devices.record.size() && f < model.fingers.size(); ++f)
     if (options.devices.record[f])
       table("/devices/" + model.fingers[f].name, recordings::DeviceRecorder::row_size(options.devices.counters), 1.0,

@@ -159,7 +159,7 @@ class VertexScreen {
 
 }  // namespace
 
-int floor_contact(const Model& model, int body, BodyState& bs, Wrench& out) {
+int floor_contact(const Model& model, int body, BodyState& bs, Wrench& out, std::vector<ContactRecord>* points) {
   out = Wrench{};
   const BodyParams& bp = model.bodies[body];
   const ContactPair pair = floor_pair(model, body);
@@ -183,6 +183,7 @@ int floor_contact(const Model& model, int body, BodyState& bs, Wrench& out) {
     const Vec3 f(f_t.x(), f_t.y(), f_n);
     out.force += f;
     out.torque += p.r.cross(f);
+    if (points != nullptr) points->push_back(ContactRecord{kFloor, body, p.x, Vec3::UnitZ(), f});
     roll_on(bs, p, floor_z, vc);
   }
   return touching;
@@ -510,16 +511,17 @@ int BodyContacts::points(const Model& model, const State& state, int a, int b, M
   return n;
 }
 
-void BodyContacts::step(const Model& model, State& state, std::vector<Wrench>& wrenches, std::vector<int>& points) {
-  run(model, state, &wrenches, points, nullptr);
+void BodyContacts::step(const Model& model, State& state, std::vector<Wrench>& wrenches, std::vector<int>& points,
+                        std::vector<ContactRecord>* records) {
+  run(model, state, &wrenches, points, nullptr, records);
 }
 
 void BodyContacts::couplings(const Model& model, State& state, std::vector<Coupling>& out, std::vector<int>& points) {
-  run(model, state, nullptr, points, &out);
+  run(model, state, nullptr, points, &out, nullptr);
 }
 
 void BodyContacts::run(const Model& model, State& state, std::vector<Wrench>* wrenches, std::vector<int>& points,
-                       std::vector<Coupling>* out) {
+                       std::vector<Coupling>* out, std::vector<ContactRecord>* records) {
   Impl& im = *impl_;
   const int nb = static_cast<int>(model.bodies.size());
   if (nb < 2) return;
@@ -619,6 +621,7 @@ void BodyContacts::run(const Model& model, State& state, std::vector<Wrench>* wr
       (*wrenches)[b].torque += rb.cross(f);
       (*wrenches)[a].force -= f;
       (*wrenches)[a].torque -= ra.cross(f);
+      if (records != nullptr) records->push_back(ContactRecord{a, b, mp.point, nrm, f});
     }
     std::copy(im.next.begin(), im.next.begin() + n, pc.points.begin());
     pc.count = n;

@@ -118,12 +118,14 @@ void Simulation::servo_stage(const Input& input, TickRecord& record) {
 void Simulation::physics_stage(const Input& input, TickRecord& record) {
   const double pitch_change = gimbal_pitch_change(input);
   wake_touched_bodies();
+  record.contacts.clear();
   if (model_.integrator == Integrator::kPaper) {
-    paper_contacts();
+    paper_contacts(record);
     for (std::size_t b = 0; b < model_.bodies.size(); ++b) paper_body_step(static_cast<int>(b), pitch_change, record);
   } else {
     implicit_contacts(input);
     implicit_solve(pitch_change);
+    if (record_contacts_) record_implicit_contacts(record);
     for (std::size_t b = 0; b < model_.bodies.size(); ++b) implicit_body_step(static_cast<int>(b), record);
   }
   collision_stale_ = true;
@@ -154,11 +156,11 @@ void Simulation::wake_touched_bodies() {
   }
 }
 
-void Simulation::paper_contacts() {
+void Simulation::paper_contacts(TickRecord& record) {
   // Body against body first, every pair at the state of this tick (equal and opposite).
   std::fill(contact_wrench_.begin(), contact_wrench_.end(), Wrench{});
   std::fill(contact_points_.begin(), contact_points_.end(), 0);
-  body_contacts_.step(model_, state_, contact_wrench_, contact_points_);
+  body_contacts_.step(model_, state_, contact_wrench_, contact_points_, record_contacts_ ? &record.contacts : nullptr);
 }
 
 // The paper's step of one body (section 3.1): the residual force and torque at the state of this
@@ -186,7 +188,7 @@ void Simulation::paper_body_step(int b, double pitch_change, TickRecord& record)
         floor_clear_[b] = 1;
       }
     } else {
-      floor_contacts = floor_contact(model_, b, bs, floor);
+      floor_contacts = floor_contact(model_, b, bs, floor, record_contacts_ ? &record.contacts : nullptr);
       floor_clear_[b] = floor_contacts == 0 ? 1 : 0;
     }
   }

@@ -145,6 +145,19 @@ void Simulation::implicit_solve(double pitch_change) {
   }
 }
 
+// The floor and body points of the solve with the forces it found, in the couplings' order: a
+// floor point only while it pushes or rubs (not kOff, as BodyRecord::floor_contacts counts), a
+// body point always (as body_contacts counts; zero force when kOff).
+void Simulation::record_implicit_contacts(TickRecord& record) const {
+  for (std::size_t i = 0; i < couplings_.size(); ++i) {
+    const Coupling& c = couplings_[i];
+    if (c.source == Coupling::Source::kFinger) continue;
+    if (c.source == Coupling::Source::kFloor && implicit_.mode(i) == CouplingMode::kOff) continue;
+    record.contacts.push_back(ContactRecord{c.source == Coupling::Source::kFloor ? kFloor : c.a, c.b, c.point,
+                                            c.normal, implicit_.force(i)});
+  }
+}
+
 // One body after the solve: its velocity change as the force and torque that make it, its grasp
 // rule's rate about the axis set directly, the move, then the rule's turn. The dead band (section
 // 5) acts on the rule's torque about the axis only (plan_axis_rule): the paper's band stops the

@@ -29,6 +29,13 @@ TickRecord make_tick_record(const Model& model) {
   r.servo.resize(model.fingers.size());
   r.haptic.resize(model.fingers.size());
   r.physics.resize(model.bodies.size());
+  // Room for every contact point a step can have, as Simulation reserves its couplings: each
+  // body's floor points and kMaxPairPoints per pair of bodies, so that no step allocates.
+  const std::size_t n = model.bodies.size();
+  std::size_t points = kMaxPairPoints * n * (n > 0 ? n - 1 : 0) / 2;
+  if (model.floor.enabled)
+    for (const BodyParams& bp : model.bodies) points += static_cast<std::size_t>(floor_point_count(bp.shape));
+  r.contacts.reserve(points);
   return r;
 }
 

@@ -226,17 +226,19 @@ void share_table_rows(SharedRows& shared, LoopColumns& cols, const OpenTrace& a,
   shared.step = std::min(shared.a->block, shared.b->block);
 }
 
-// Throws unless the ticks of `c` (read whole) strictly increase.
-void check_increasing(const std::vector<std::int64_t>& ticks, const Column& c) {
+// Throws unless the ticks of `c` (read whole) strictly increase, or with `repeats` (a table of
+// several rows per tick, /contacts) never decrease.
+void check_increasing(const std::vector<std::int64_t>& ticks, const Column& c, bool repeats) {
   for (std::size_t r = 1; r < ticks.size(); ++r)
-    if (ticks[r] <= ticks[r - 1])
+    if (ticks[r] < ticks[r - 1] || (!repeats && ticks[r] == ticks[r - 1]))
       fail("trace " + quoted(c.file) + ", dataset " + quoted(c.path) + ": ticks do not increase at row " +
            std::to_string(r) + " (" + std::to_string(ticks[r - 1]) + " then " +
            std::to_string(ticks[r]) + ")");
 }
 
 // Pairs the rows of A and B with the same tick (a merge join of two increasing tick columns),
-// counting the ticks found in one trace only in `loop`.
+// counting the ticks found in one trace only in `loop`. Where a tick has several rows, its k-th
+// row in A meets its k-th in B, and rows beyond the shorter run count as found in one only.
 Alignment align(const std::vector<std::int64_t>& ticks_a, const std::vector<std::int64_t>& ticks_b,
                 const std::vector<double>& times_a, LoopAlignment& loop) {
   Alignment al;
@@ -356,8 +358,9 @@ void compare_loop(const OpenTrace& a, const OpenTrace& b, const std::string& gro
 
   const auto ticks_a = read_all<std::int64_t>(cols.a[cols.tick], cols.rows_a, options.block_rows);
   const auto ticks_b = read_all<std::int64_t>(cols.b[cols.tick], cols.rows_b, options.block_rows);
-  check_increasing(ticks_a, cols.a[cols.tick]);
-  check_increasing(ticks_b, cols.b[cols.tick]);
+  const bool repeats = group == "contacts";
+  check_increasing(ticks_a, cols.a[cols.tick], repeats);
+  check_increasing(ticks_b, cols.b[cols.tick], repeats);
   const auto times_a = read_all<double>(cols.a[cols.time], cols.rows_a, options.block_rows);
   LoopAlignment loop;
   loop.loop = group;

@@ -58,6 +58,8 @@ std::vector<schema::ColumnDoc> schema::recorded_columns() {
   document(out, physics, kLoopFields);
   document(out, physics, kPhysicsFields);
   document(out, physics + object, kBodyFields);
+  document(out, under(kContacts), kLoopFields);
+  document(out, under(kContacts), kContactFields);
   std::string device = "/";
   device += kDevices;
   device += "<finger>/";
@@ -73,6 +75,7 @@ TraceRecorder::Rows TraceRecorder::row_sizes(const graspsim::Model& model) {
   r.servo = loop + f * size_of_fields(schema::kServoFingerFields);
   r.haptic = loop + f * size_of_fields(schema::kHapticFingerFields);
   r.physics = loop + size_of_fields(schema::kPhysicsFields) + b * size_of_fields(schema::kBodyFields);
+  r.contacts = loop + size_of_fields(schema::kContactFields);
   return r;
 }
 
@@ -81,7 +84,8 @@ TraceRecorder::TraceRecorder(TraceWriter& writer, const graspsim::Model& model,
     : servo_rate_(static_cast<double>(model.rates.servo)),
       servo_every_(select.of(RecordedLoop::kServo)),
       haptic_every_(select.of(RecordedLoop::kHaptic)),
-      physics_every_(select.of(RecordedLoop::kPhysics)) {
+      physics_every_(select.of(RecordedLoop::kPhysics)),
+      contacts_every_(select.of(RecordedLoop::kContacts)) {
   for (const auto& f : model.fingers) check_name("finger", f.name);
   for (const auto& b : model.bodies) check_name("object", b.name);
   // A table's chunk covers chunk_ticks servo ticks of its kept rows.
@@ -92,6 +96,12 @@ TraceRecorder::TraceRecorder(TraceWriter& writer, const graspsim::Model& model,
   servo_ = table(schema::kServo, servo_every_, 1);
   haptic_ = table(schema::kHaptic, haptic_every_, d.haptic);
   physics_ = table(schema::kPhysics, physics_every_, d.physics);
+  // A variable number of rows per tick: the writer's default block.
+  contacts_ = contacts_every_ > 0 ? &writer.table(std::string(schema::kContacts), 0) : nullptr;
+  if (contacts_) {
+    contacts_loop_ = declare(*contacts_, "", schema::kLoopFields);
+    contact_fields_ = declare(*contacts_, "", schema::kContactFields);
+  }
 
   if (servo_) servo_loop_ = declare(*servo_, "", schema::kLoopFields);
   if (haptic_) haptic_loop_ = declare(*haptic_, "", schema::kLoopFields);
@@ -159,6 +169,14 @@ void TraceRecorder::record(const graspsim::TickRecord& rec,
     fill<schema::kPhysicsFields>(row, physics_hash_, schema::PhysicsRow{state_hash(after)});
     for (std::size_t k = 0; k < objects_.size(); ++k)
       fill<schema::kBodyFields>(row, objects_[k], rec.physics[k]);
+  }
+
+  if (rec.physics_ran && kept(contacts_, contacts_every_, contacts_wait_)) {
+    for (const graspsim::ContactRecord& c : rec.contacts) {
+      double* row = contacts_->append_row();
+      fill<schema::kLoopFields>(row, contacts_loop_, loop);
+      fill<schema::kContactFields>(row, contact_fields_, c);
+    }
   }
 }
 

@@ -75,7 +75,8 @@ TEST_CASE("a --record argument parses to its loops and strides and prints back t
   CHECK(s.text() == "servo:10,physics:1");
   CHECK(rec::RecordSelection::parse(s.text()).every == s.every);
   CHECK(rec::RecordSelection{}.everything());
-  CHECK(rec::RecordSelection{}.text() == "servo:1,haptic:1,physics:1,devices:1");
+  CHECK(rec::RecordSelection{}.text() == "servo:1,haptic:1,physics:1,devices:1");   // no contacts
+  CHECK(rec::RecordSelection::parse("physics,contacts:2").text() == "physics:1,contacts:2");
   // A trace without the attribute was written before it: every loop at every tick.
   CHECK(rec::RecordSelection::from_attribute(std::nullopt).everything());
   for (const char* bad : {"", "foo", "physics:0", "physics:-1", "physics:x", "physics:", "physics,physics", ",",
@@ -134,6 +135,43 @@ TEST_CASE("a run with --record LOOP:EVERY keeps exactly every EVERY-th tick of t
   // The default records everything, and says so.
   CHECK(rec::read_string_attribute(full, "/", "record") == "servo:1,haptic:1,physics:1,devices:1");
   CHECK(static_cast<std::int64_t>(ticks(full, "servo").size()) == kServoTicks);
+}
+
+// /contacts: a row per floor or body-body point of every physics tick, as many per tick as the
+// /physics counts of the box (floor_contacts + body_contacts: the same points; the lift has no
+// sleep, so no point is left out), ticks never decreasing; compare aligns the k-th row of a
+// tick with the k-th (a trace against itself: every row matched, the same) and lists the table
+// as one-sided against a trace without it, still the same.
+TEST_CASE("a run recording contacts writes one row per contact point and compare aligns them", "[record]") {
+  const std::string dir = fresh_dir("record_contacts");
+  const std::string with = dir + "/with.h5", without = dir + "/without.h5";
+  REQUIRE(run_in(dir, "--quiet --record physics,contacts --out " + with).status == 0);
+  REQUIRE(run_in(dir, "--quiet --record physics --out " + without).status == 0);
+  const std::vector<double> physics = ticks(with, "physics");
+  const std::vector<double> contact_ticks = ticks(with, "contacts");
+  const std::vector<double> floor = rec::read_dataset(with, "/physics/objects/box/floor_contacts").values;
+  const std::vector<double> body = rec::read_dataset(with, "/physics/objects/box/body_contacts").values;
+  REQUIRE(physics.size() == static_cast<std::size_t>(kPhysicsTicks));
+  std::size_t row = 0, expected = 0;
+  for (std::size_t k = 0; k < physics.size(); ++k) {
+    std::size_t here = 0;
+    while (row < contact_ticks.size() && contact_ticks[row] == physics[k]) ++row, ++here;
+    INFO("physics tick " << physics[k]);
+    CHECK(here == static_cast<std::size_t>(floor[k] + body[k]));
+    expected += here;
+  }
+  CHECK(row == contact_ticks.size());   // every row at a physics tick, in tick order
+  CHECK(expected > 4);                  // the box stood on its four corners before the lift
+  const rec::CompareResult self = rec::compare_traces(with, with, {});
+  CHECK(self.same());
+  bool aligned = false;
+  for (const rec::LoopAlignment& l : self.loops)
+    if (l.loop == "contacts") aligned = l.matched == static_cast<std::int64_t>(contact_ticks.size()) && l.only_a == 0;
+  CHECK(aligned);
+  const rec::CompareResult one_sided = rec::compare_traces(with, without, {});
+  CHECK(one_sided.same());
+  REQUIRE(one_sided.one_sided.size() == 1);
+  CHECK(one_sided.one_sided[0].table == "contacts");
 }
 
 TEST_CASE("a run with --record devices:EVERY decimates a device session's /devices table", "[record]") {

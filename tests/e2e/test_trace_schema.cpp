@@ -175,6 +175,8 @@ TEST_CASE("recordings/README.md documents exactly the datasets and attributes of
   options.out = kTmp + "/e2e_schema.h5";
   options.overrides = load.sets;
   options.devices.record = {false, true};   // the index finger's samples in /devices/index
+  // And /contacts, which a run records only when asked (the box starts on the floor: it has rows).
+  options.trace.record = recordings::RecordSelection::parse("servo,haptic,physics,devices,contacts");
   const app::RunResult result = app::run_scenario(scenario, options);
   REQUIRE(result.error.empty());
 
@@ -230,7 +232,7 @@ TEST_CASE("recordings/README.md documents exactly the recorders' field tables", 
     // Column notes: attributes on a column path (the table attributes of /devices/<finger>,
     // device, mapping and max_force, are the runner's).
     if (on.rfind("/servo/", 0) == 0 || on.rfind("/haptic/", 0) == 0 || on.rfind("/physics/", 0) == 0 ||
-        (on.rfind("/devices/<finger>/", 0) == 0))
+        on.rfind("/contacts/", 0) == 0 || (on.rfind("/devices/<finger>/", 0) == 0))
       documented_notes.insert({on, code(row[1]), row[2]});
   }
 
@@ -241,9 +243,10 @@ TEST_CASE("recordings/README.md documents exactly the recorders' field tables", 
     tabled.insert({c.path, shape, recordings::name_of(c.dtype), c.units});
     if (!c.note.name.empty()) tabled_notes.insert({c.path, std::string(c.note.name), "string"});
   }
-  // 2 + 4 + 2 + 8 + 3 + 11 + 10 columns: tick and time in each loop, the state hash, the
-  // per-finger and per-object fields, and a device's 8 fields and 2 counters.
-  CHECK(tabled.size() == 40);
+  // 2 + 4 + 2 + 8 + 3 + 11 + 7 + 10 columns: tick and time in each loop, the state hash, the
+  // per-finger and per-object fields, /contacts' tick, time and 5 fields, and a device's 8
+  // fields and 2 counters.
+  CHECK(tabled.size() == 47);
 
   INFO("in the field tables, not in the README (path | shape | dtype | units):\n" << list(minus(tabled, documented)));
   INFO("in the README, not in the field tables:\n" << list(minus(documented, tabled)));

@@ -243,17 +243,20 @@ TEST_CASE("a step with body-body contact allocates no heap memory", "[schedule][
   m.bodies.push_back(graspsim::test::make_box("falling", 0.1, Vec3(0.02, 0.02, 0.02), Vec3(0.01, 0.0, 0.09),
                                               Material{0.5, 1000.0, 5.0}));
   Simulation sim(m);
+  sim.record_contacts(true);   // and the contact points listed for a trace
   Input input = make_input(m);
   TickRecord record = make_tick_record(m);
   for (int n = 0; n < 10; ++n) sim.step(input, record);
   const long before = g_allocations.load();
-  int touching = 0;
+  int touching = 0, recorded = 0;
   for (int n = 0; n < 3000; ++n) {
     sim.step(input, record);
     if (record.physics_ran && record.physics[2].body_contacts > 0) ++touching;
+    if (record.physics_ran) recorded = std::max(recorded, static_cast<int>(record.contacts.size()));
   }
   CHECK(g_allocations.load() - before == 0);
   CHECK(touching > 10);   // the falling box landed
+  CHECK(recorded > 8);    // and its points were recorded beside the 4 + 4 of the resting two
 }
 
 // The real-time profile's scene (bench/mesh_grasp_scene.hpp): three fingers close on a

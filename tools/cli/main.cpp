@@ -87,10 +87,13 @@ constexpr const char* kHelp =
     "  --no-trace           write no trace at all (no file, no writer thread); the summary\n"
     "                       and the expectations are as with one, and set the exit status\n"
     "  --record LOOP[:EVERY],...\n"
-    "                       record only these loops (servo, haptic, physics, devices), each\n"
-    "                       at every EVERY-th tick of its own loop (default 1), e.g.\n"
-    "                       --record physics or --record physics,servo:10; default: every loop\n"
-    "                       at every tick. Written to the trace's root attribute `record`;\n"
+    "                       record only these loops (servo, haptic, physics, devices,\n"
+    "                       contacts), each at every EVERY-th tick of its own loop (default\n"
+    "                       1; contacts: of the physics loop), e.g. --record physics or\n"
+    "                       --record physics,servo:10; default: every loop at every tick but\n"
+    "                       contacts (every contact point of the bodies with its force, a\n"
+    "                       row per point: servo,haptic,physics,devices,contacts adds it).\n"
+    "                       Written to the trace's root attribute `record`;\n"
     "                       `graspsim replay` needs servo (and devices) at every tick\n"
     "  --refuse-unstable    stop the run at the first unstable mode the stability check\n"
     "                       finds (as the scenario field stability = \"refuse\"), exit 2;\n"
@@ -301,7 +304,7 @@ int run_command(const std::vector<std::string>& args) {
       if (record) return bad_input("--record given twice: name every loop in one, e.g. --record physics,servo:10");
       const std::string* v = value();
       if (!v || v->empty() || v->front() == '-')
-        return bad_input("--record needs LOOP[:EVERY],... (loops: servo, haptic, physics, devices)" +
+        return bad_input("--record needs LOOP[:EVERY],... (loops: servo, haptic, physics, devices, contacts)" +
                          (v ? " (got '" + *v + "')" : std::string()));
       try {
         record = graspsim::recordings::RecordSelection::parse(*v);

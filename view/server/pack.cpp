@@ -129,13 +129,19 @@ Packed pack_scene(const ViewScene& s) {
     blob.add(p + "body", f.body, "f64");
     fingers += std::string(j ? ",\n    " : "") + "{\"name\": " + json_string(f.name) + ", \"radius\": " + number(f.radius) + "}";
   }
+  blob.add_ticks("contact_tick", s.contact_tick);
+  blob.add("contact/a", s.contact_a, "f64");
+  blob.add("contact/b", s.contact_b, "f64");
+  blob.add("contact/point", s.contact_point, "f64");
+  blob.add("contact/force", s.contact_force, "f64");
   Packed out;
   out.json = "{\n  \"live\": " + std::string(s.live ? "true" : "false") + ",\n  \"trace\": " + json_string(s.trace) + ",\n  \"scenario\": " + json_string(s.scenario_name) +
              ",\n  \"status\": " + json_string(s.status) + ",\n  \"note\": " + json_string(s.note) +
              ",\n  \"rates\": {\"servo\": " + std::to_string(s.rate_servo) + ", \"haptic\": " +
              std::to_string(s.rate_haptic) + ", \"physics\": " + std::to_string(s.rate_physics) +
              "},\n  \"duration\": " + number(s.duration) + ",\n  \"floor\": {\"enabled\": " +
-             (s.floor ? "true" : "false") + ", \"height\": " + number(s.floor_height) + "},\n  \"bodies\": [\n    " +
+             (s.floor ? "true" : "false") + ", \"height\": " + number(s.floor_height) + "},\n  \"contacts\": " +
+             (s.contacts ? "true" : "false") + ",\n  \"bodies\": [\n    " +
              bodies + "],\n  \"fingers\": [\n    " + fingers + "],\n  \"blob\": [\n    " + blob.layout() + "]\n}\n";
   out.blob = std::move(blob.bytes());
   return out;

@@ -193,6 +193,24 @@ void load_plot_columns(ViewScene& s, const std::vector<std::string>& columns) {
   }
 }
 
+// /contacts rows up to the last kept physics tick, when the trace recorded them.
+void load_contacts(ViewScene& s) {
+  const std::string& t = s.trace;
+  if (!rec::has_object(t, "/contacts")) return;
+  const std::vector<std::int64_t> tick = ticks(t, "contacts");
+  const std::int64_t last = s.physics_tick.empty() ? -1 : s.physics_tick.back();
+  const std::size_t n = static_cast<std::size_t>(std::upper_bound(tick.begin(), tick.end(), last) - tick.begin());
+  const auto first = [n](const rec::Dataset& d, std::size_t width) {
+    return std::vector<double>(d.values.begin(), d.values.begin() + static_cast<std::ptrdiff_t>(width * n));
+  };
+  s.contacts = true;
+  s.contact_tick.assign(tick.begin(), tick.begin() + static_cast<std::ptrdiff_t>(n));
+  s.contact_a = first(column(t, "/contacts/a", 1, n), 1);
+  s.contact_b = first(column(t, "/contacts/b", 1, n), 1);
+  s.contact_point = first(column(t, "/contacts/point", 3, n), 3);
+  s.contact_force = first(column(t, "/contacts/force", 3, n), 3);
+}
+
 }  // namespace
 
 ViewScene load_scene(const std::string& trace) {
@@ -233,6 +251,7 @@ ViewScene load_scene(const std::string& trace) {
     }
     load_columns(s, columns);
     load_plot_columns(s, columns);
+    load_contacts(s);
     if (s.status != "complete") s.note = cut_note(s);
     if (!scenario)
       s.note += (s.note.empty() ? "" : " ") + std::string("The recorded scenario does not load here (") + why +

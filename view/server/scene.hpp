@@ -60,6 +60,14 @@ struct ViewScene {
   std::vector<std::int64_t> haptic_tick;    // servo ticks of the /haptic rows kept
   std::vector<BodyView> bodies;             // Model::bodies order
   std::vector<FingerView> fingers;          // Model::fingers order
+  // /contacts at the kept physics ticks (a trace recorded without it: contacts false, no rows):
+  // one entry per floor or body-body point, in the table's order.
+  bool contacts = false;
+  std::vector<std::int64_t> contact_tick;   // servo tick of the physics step
+  std::vector<double> contact_a;            // 1: -2 floor, else the body pushed by -force
+  std::vector<double> contact_b;            // 1: the body pushed by force
+  std::vector<double> contact_point;        // m, world: 3 per row
+  std::vector<double> contact_force;        // N, world: 3 per row, on b
 };
 
 // Reads `trace`. Tables are cut to the ticks all of them hold (a cut trace's tables may differ by

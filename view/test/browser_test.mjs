@@ -14,6 +14,9 @@
 //     friction circle's radius is mu depth; each step button moves one period of its loop; the
 //     view buttons look along the axes; the grasp axis is drawn where the grasp rule holds
 //     (page_checks.mjs);
+//   - the lift, recorded with /contacts: the contact points and forces drawn at a tick before the
+//     fingers touch are the trace's rows, and the floor's forces on the resting box sum to its
+//     weight (page_checks.mjs);
 //   - two runs overlaid (`graspsim view A B`): B's drawn pose is B's trace, the divergent tick
 //     marked is the one `graspsim compare A B` reports;
 // and that a cut trace is shown up to its last tick with a note, and that bad input (a missing
@@ -25,7 +28,7 @@ import { mkdirSync, rmSync, writeFileSync, statSync, existsSync } from 'node:fs'
 import { createServer } from 'node:net';
 import { join } from 'node:path';
 import { decodePng } from './png.mjs';
-import { checkCircleMuDepth, checkGrasp, checkSeries, checkSteps, checkViews } from './page_checks.mjs';
+import { checkCircleMuDepth, checkContacts, checkGrasp, checkSeries, checkSteps, checkViews } from './page_checks.mjs';
 
 const [cli, src, tmpRoot] = process.argv.slice(2);
 const tmp = join(tmpRoot, 'view_browser');
@@ -121,11 +124,13 @@ function firstChange(trace, finger) {
 }
 
 // MU: the friction coefficient of the scenario's finger contacts (its param `mu`); CONTROLS: also
-// check the step and view buttons (the same page code for every trace: one scenario does).
+// check the step and view buttons (the same page code for every trace: one scenario does), and
+// record /contacts and check the contact points drawn.
 // Returns the trace as h5py read it.
 async function checkScenario(name, scenario, mu, controls) {
   const file = join(tmp, `${name}.h5`);
-  const r = run(['run', join(src, 'scenarios', scenario), '--out', file, '--quiet']);
+  const record = controls ? ['--record', 'servo,haptic,physics,devices,contacts'] : [];
+  const r = run(['run', join(src, 'scenarios', scenario), '--out', file, '--quiet', ...record]);
   if (r.status !== 0) return fail(`${name}: graspsim run exited ${r.status}: ${r.out}`);
   const trace = dump(file);
   const { child, url } = await serve(file);
@@ -196,6 +201,7 @@ async function checkScenario(name, scenario, mu, controls) {
     await checkCircleMuDepth(t, page, trace, name, mu);
     if (controls) await checkSteps(t, page, trace, name, await hook(page, () => window.graspsimView.scene.rates));
     await checkGrasp(t, page, trace, name);
+    if (controls) await checkContacts(t, page, trace, name);
 
     // Screenshot in the middle of the run: not blank.
     await hook(page, (t) => window.graspsimView.seek(t), pt[n >> 1]);

@@ -136,3 +136,52 @@ export async function checkGrasp(t, page, trace, name) {
                 `the grasp axis joins ${on.join(' and ')}'s god-objects, torsion ${rec.torsion[held]} N m`);
   }
 }
+
+// Contact points: at a physics tick while the body rests on the floor, before any finger touches
+// it, the page draws one dot per /contacts row of that tick at the recorded point (exactly:
+// float64 passed through), from that tick's rows (not another tick's, which at rest would look the
+// same), with an arrow showing the recorded force (to 1e-9 relative: the arrow
+// holds it as a unit direction, a quaternion, and a length, whose round trip costs a few ulps),
+// floor and body-body points in two colours; and the floor's forces on each body sum to its
+// weight m g. Why that holds: the body is at rest (its /physics velocity below 1e-12 m/s, checked),
+// so the step changed its momentum by nothing, m dv = (F_floor + m g) h = 0, and the floor carries
+// exactly its weight up to the round-off of the step's sums (~1e-15 relative); 1e-9 spares that
+// and still catches a point missing (a quarter of the weight) or a row of another tick.
+export async function checkContacts(t, page, trace, name) {
+  const { check, hook } = t;
+  if (!trace.contacts) return check(false, `${name}: the trace has no /contacts (recorded without it)`);
+  const pt = trace.physics_tick;
+  let touch = trace.haptic_tick.length;   // first haptic row with a finger in contact
+  for (const f of Object.values(trace.fingers)) { const i = f.state.findIndex((s) => s !== 0); if (i >= 0) touch = Math.min(touch, i); }
+  const row = rowAt(pt, (touch < trace.haptic_tick.length ? trace.haptic_tick[touch] : pt[pt.length - 1]) >> 1);
+  const tick = pt[row];
+  await hook(page, (x) => window.graspsimView.seek(x), tick);
+  const drawn = await hook(page, () => window.graspsimView.contacts());
+  const c = trace.contacts, rows = [];
+  for (let r = 0; r < c.tick.length; r++) if (c.tick[r] === tick) rows.push(r);
+  const close = (a, b) => a.every((x, k) => Math.abs(x - b[k]) <= 1e-9 * Math.max(1e-9, Math.hypot(...b)));
+  const same = drawn.length === rows.length && rows.length > 0 && rows.every((r, k) => {
+    const d = drawn[k];
+    return d.row === r && d.a === c.a[r] && d.b === c.b[r] && d.point.every((x, j) => x === c.point[r][j]) &&
+           d.origin.every((x, j) => x === c.point[r][j]) && close(d.force, c.force[r]) &&
+           d.kind === (c.a[r] === -2 ? 'floor' : 'body');
+  });
+  check(same, `${name}: at tick ${tick} the page draws the trace's ${rows.length} /contacts rows: each dot at its point, ` +
+              `its arrow its force${same ? '' : ` (drawn ${JSON.stringify(drawn)})`}`);
+  // One colour per kind: every floor point's the same, and a body-body point's (where any) another.
+  const colours = new Set(drawn.map((d) => `${d.kind} ${d.colour}`)), kinds = new Set(drawn.map((d) => d.kind));
+  check(colours.size === kinds.size && new Set(drawn.map((d) => d.colour)).size === kinds.size,
+        `${name}: floor and body-body points are drawn in their own colours (${[...colours].join(', ')})`);
+  const g = Math.hypot(...trace.gravity);
+  for (const [i, b] of Object.keys(trace.bodies).sort().entries()) {
+    const index = (await hook(page, () => window.graspsimView.scene.bodies.map((o) => o.name))).indexOf(b);
+    const on = drawn.filter((d) => d.a === -2 && d.b === index);
+    if (!on.length) continue;
+    const sum = [0, 1, 2].map((k) => on.reduce((s, d) => s + c.force[rows[drawn.indexOf(d)]][k], 0));
+    const weight = trace.mass[b] * g, v = trace.bodies[b].velocity[row];
+    const rest = Math.hypot(...v) < 1e-12;
+    check(rest && Math.abs(sum[2] - weight) <= 1e-9 * weight && Math.hypot(sum[0], sum[1]) <= 1e-9 * weight,
+          `${name}: at tick ${tick} body ${b} (${i}) at rest (speed ${Math.hypot(...v)} m/s) gets ${JSON.stringify(sum)} N ` +
+          `from its ${on.length} floor points, its weight m g = ${weight} N`);
+  }
+}

@@ -2,7 +2,9 @@
 """What the browser test compares the page with, read by h5py (not by graspsim's own reader):
 every /physics row's tick, each body's position, quaternion, grasp area and torsion, and each
 finger's /haptic tick, contact state, contacted body, god-object, force, surface point, depth and
-friction radius, and its HIP from the /servo row at each haptic tick. Usage: trace_dump.py TRACE.h5 -> JSON on stdout. A cut trace is opened in
+friction radius, and its HIP from the /servo row at each haptic tick; where the trace recorded
+/contacts, its rows (tick, a, b, point, force), each body's mass and gravity (from the root
+attribute `parameters`). Usage: trace_dump.py TRACE.h5 -> JSON on stdout. A cut trace is opened in
 SWMR mode, as recordings/README.md says h5py must."""
 import json
 import sys
@@ -26,7 +28,8 @@ def main(path):
             "bodies": {b: {"position": physics[f"objects/{b}/position"].tolist(),
                            "quaternion": physics[f"objects/{b}/quaternion"].tolist(),
                            "grasp_area": physics[f"objects/{b}/grasp_area"].tolist(),
-                           "torsion": physics[f"objects/{b}/torsion"].tolist()} for b in bodies},
+                           "torsion": physics[f"objects/{b}/torsion"].tolist(),
+                           "velocity": physics[f"objects/{b}/velocity"].tolist()} for b in bodies},
             "haptic_tick": haptic["tick"].tolist(),
             "fingers": {n: {"state": haptic[f"fingers/{n}/state"].tolist(),
                             "surface_point": haptic[f"fingers/{n}/surface_point"].tolist(),
@@ -37,6 +40,14 @@ def main(path):
                             "force": haptic[f"fingers/{n}/force"].tolist(),
                             "hip": servo[f"fingers/{n}/hip"][at_haptic].tolist()} for n in fingers},
         }
+        if "contacts" in f:
+            c = f["contacts"][:]
+            out["contacts"] = {k: c[k].tolist() for k in ("tick", "a", "b", "point", "force")}
+            params = f.attrs["parameters"]
+            params = params if isinstance(params, str) else params.decode()
+            values = dict(line.split(" = ", 1) for line in params.splitlines() if " = " in line)
+            out["mass"] = {b: float(values[f"objects.{b}.mass"]) for b in bodies}
+            out["gravity"] = [float(x) for x in values["gravity"].split(",")]
     json.dump(out, sys.stdout)
 
 

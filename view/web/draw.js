@@ -1,4 +1,5 @@
-// The 3D scene of a trace: floor, bodies with their shapes, fingers (HIP, god-object, force).
+// The 3D scene of a trace: floor, bodies with their shapes, fingers (HIP, god-object, force),
+// contact points of the bodies (floor and body-body) with their forces.
 // World frame as in graspsim: metres, z up. Poses are set from the trace's float64 values as they
 // are (JavaScript numbers are float64), so a drawn pose is the recorded one to the bit.
 import * as THREE from 'three';
@@ -7,6 +8,33 @@ export const STATE_COLOURS = ['#9e9e9e', '#2e9e44', '#e4572e'];   // 0 free, 1 s
 const FORCE_SCALE = 0.01;       // m of arrow per N
 const POINT_PAD = 0.004;        // m: god-object radius drawn for a point pad (radius 0)
 const HIP_RADIUS = 0.002;       // m
+export const CONTACT_COLOURS = { floor: '#00897b', body: '#8d6e63' };   // floor points, body-body points
+const CONTACT_RADIUS = 0.0015;  // m: a contact point's dot
+
+// Sets an arrow from `origin` along `force` (N), FORCE_SCALE m per N (the fingers' scale); hidden
+// for a force of (nearly) 0.
+function setArrow(arrow, origin, force) {
+  const n = Math.hypot(force[0], force[1], force[2]);
+  arrow.visible = n > 1e-9;
+  if (!arrow.visible) return;
+  arrow.position.copy(origin);
+  arrow.setDirection(new THREE.Vector3(force[0] / n, force[1] / n, force[2] / n));
+  const len = n * FORCE_SCALE;
+  arrow.setLength(len, Math.min(0.3 * len, 0.01), Math.min(0.15 * len, 0.005));
+}
+
+// One contact point: a dot and its force's arrow, in the colour of its kind. Drawn over
+// everything (no depth test): a floor point is under the floor by its penetration, and its
+// arrow, about as long, would be hidden by the floor's plane.
+function makeContact(kind) {
+  const colour = CONTACT_COLOURS[kind];
+  const dot = new THREE.Mesh(new THREE.SphereGeometry(CONTACT_RADIUS, 10, 6),
+                             new THREE.MeshBasicMaterial({ color: colour, depthTest: false }));
+  const arrow = new THREE.ArrowHelper(new THREE.Vector3(0, 0, 1), new THREE.Vector3(), 0.01, colour);
+  arrow.line.material.depthTest = arrow.cone.material.depthTest = false;
+  dot.renderOrder = arrow.line.renderOrder = arrow.cone.renderOrder = 1;
+  return { kind, dot, arrow, force: [0, 0, 0], a: -2, b: 0, row: -1 };
+}
 
 // A body's geometry in its body frame (origin at the centre of mass; cylinder and capsule
 // along body z, three.js builds them along y).
@@ -108,6 +136,8 @@ export class SceneView {
       return v;
     });
     this.grasps = scene.bodies.map(() => { const g = makeGrasp(); this.scene.add(g.axis, g.arc); return g; });
+    this.contactPool = { floor: [], body: [] };   // drawn objects, reused from tick to tick
+    this.contacts = [];                            // the ones shown now, in the trace's row order
     this.ghosts = [];
     this.ghostFingers = [];
     this.resize();
@@ -194,14 +224,7 @@ export class SceneView {
     f.state = state;
     f.colour = STATE_COLOURS[state] ?? '#000000';
     f.go.material.color.set(f.colour);
-    const n = Math.hypot(force[0], force[1], force[2]);
-    f.arrow.visible = n > 1e-9;
-    if (f.arrow.visible) {
-      f.arrow.position.copy(f.go.position);
-      f.arrow.setDirection(new THREE.Vector3(force[0] / n, force[1] / n, force[2] / n));
-      const len = n * FORCE_SCALE;
-      f.arrow.setLength(len, Math.min(0.3 * len, 0.01), Math.min(0.15 * len, 0.005));
-    }
+    setArrow(f.arrow, f.go.position, force);
     // The circle of radius mu depth about the surface point, in the face's plane: its normal is
     // (surface point - HIP) / depth. Hidden while free.
     const nx = surface[0] - hip[0], ny = surface[1] - hip[1], nz = surface[2] - hip[2];
@@ -212,6 +235,47 @@ export class SceneView {
       f.circle.quaternion.setFromUnitVectors(new THREE.Vector3(0, 0, 1), new THREE.Vector3(nx / depth, ny / depth, nz / depth));
       f.circle.scale.setScalar(frictionRadius);
     }
+  }
+
+  // The contact points of one physics tick: each {row (of /contacts), a, b, point (m), force (N,
+  // on b)}; a = -2 is the floor. Dots and arrows come from a pool per kind, the rest hidden.
+  setContacts(rows) {
+    const used = { floor: 0, body: 0 };
+    this.contacts = rows.map((r) => {
+      const kind = r.a === -2 ? 'floor' : 'body';
+      const pool = this.contactPool[kind];
+      if (used[kind] === pool.length) {
+        const c = makeContact(kind);
+        this.scene.add(c.dot, c.arrow);
+        pool.push(c);
+      }
+      const c = pool[used[kind]++];
+      c.row = r.row;
+      c.a = r.a;
+      c.b = r.b;
+      c.force = r.force;
+      c.dot.visible = true;
+      c.dot.position.set(r.point[0], r.point[1], r.point[2]);
+      setArrow(c.arrow, c.dot.position, r.force);
+      return c;
+    });
+    for (const kind of ['floor', 'body']) {
+      for (const c of this.contactPool[kind].slice(used[kind])) c.dot.visible = c.arrow.visible = false;
+    }
+  }
+
+  // What setContacts drew, read back from the objects: per point its /contacts row, a, b, kind and colour, the
+  // dot's position (m) and the force the arrow shows (N: its direction times its length / scale,
+  // 0 when hidden) from the arrow's origin.
+  drawnContacts() {
+    return this.contacts.map((c) => {
+      const dir = new THREE.Vector3(0, 1, 0).applyQuaternion(c.arrow.quaternion);   // ArrowHelper points along +y
+      const n = c.arrow.visible ? c.arrow.cone.position.y / FORCE_SCALE : 0;        // the cone sits at the arrow's length
+      return { row: c.row, a: c.a, b: c.b, kind: c.kind, colour: `#${c.dot.material.color.getHexString()}`,
+               point: [c.dot.position.x, c.dot.position.y, c.dot.position.z],
+               origin: [c.arrow.position.x, c.arrow.position.y, c.arrow.position.z],
+               force: [dir.x * n, dir.y * n, dir.z * n] };
+    });
   }
 
   // The camera looks at what is drawn now (bodies and fingers) from the front (-y), a little

@@ -120,10 +120,25 @@ async function start() {
              torsion: col[`body/${i}/torsion`][p] };
   }
 
+  // The /contacts rows of the physics step at row p (they are in tick order: a binary search).
+  const contactTicks = col.contact_tick;
+  function contactRows(p) {
+    const t = physicsTicks[p], out = [];
+    if (!scene.contacts || !contactTicks.length) return out;
+    let lo = 0, hi = contactTicks.length;
+    while (lo < hi) { const m = (lo + hi) >> 1; if (contactTicks[m] < t) lo = m + 1; else hi = m; }
+    for (let r = lo; r < contactTicks.length && contactTicks[r] === t; r++) {
+      out.push({ row: r, a: col['contact/a'][r], b: col['contact/b'][r], point: slice(col['contact/point'], r, 3),
+                 force: slice(col['contact/force'], r, 3) });
+    }
+    return out;
+  }
+
   function draw() {
     const tick = Math.floor(cursor);
     if (tick === drawn.tick) return;
     const p = rowAt(physicsTicks, tick), h = rowAt(hapticTicks, tick);
+    view.setContacts(contactRows(p));
     const info = [];
     scene.bodies.forEach((o, i) => {
       view.setBody(i, slice(col[`body/${i}/position`], p, 3), slice(col[`body/${i}/quaternion`], p, 4));
@@ -238,6 +253,10 @@ async function start() {
     // Each panel's cursor line in page coordinates, for a test's click.
     plotBox: (k) => { const r = plots.panels[k].cursor.getBoundingClientRect(); return { x: r.x, y: r.y, width: r.width, height: r.height }; },
     plotX: (k, tick) => plots.panels[k].xOf(tick),
+    // The contact points drawn at the cursor's physics step, in the trace's row order: each
+    // point and its force as drawn (dot position; arrow origin, direction times length / scale).
+    contactsRecorded: scene.contacts,
+    contacts: () => view.drawnContacts(),
     grasps: () => view.grasps.map((g) => ({ held: g.held, ends: g.ends, torsion: g.torsion, arc: g.arc.visible })),
     ghost: () => poses(view.ghosts),
     divergentTick: divergent,

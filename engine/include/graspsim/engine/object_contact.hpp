@@ -11,6 +11,7 @@
 #include "graspsim/engine/manifold.hpp"
 #include "graspsim/engine/math.hpp"
 #include "graspsim/engine/model.hpp"
+#include "graspsim/engine/record.hpp"
 #include "graspsim/engine/state.hpp"
 
 namespace graspsim {
@@ -51,8 +52,10 @@ Vec3 floor_point(const Shape& shape, const Mat3& rotation, int k, bool& rolling)
 // floor). A rolling point's material point is the one under it at the last step; after the step
 // the anchor is carried over to the new lowest point with the same stretch a - x_t, so a ball
 // rolling without slip feels no friction and one that slides does.
-// Returns the number of points in contact.
-int floor_contact(const Model& model, int body, BodyState& bs, Wrench& out);
+// Returns the number of points in contact. With `points`, each point in contact is also appended
+// to it with the force it gave (ContactRecord: a = kFloor, b = body).
+int floor_contact(const Model& model, int body, BodyState& bs, Wrench& out,
+                  std::vector<ContactRecord>* points = nullptr);
 
 // The floor points of body b for the implicit step, appended to `out` as couplings (world side
 // a = -1): the same law and anchors as floor_contact, but unclamped (the step's active set
@@ -83,8 +86,11 @@ class BodyContacts {
 
   // Adds every body-body contact wrench at the current state to `wrenches[b]` and the number of
   // contact points of b to `points[b]` (both sized to the bodies, not cleared), and updates the
-  // pairs' friction anchors in `state.pairs`. Allocation-free for pairs of polyhedra.
-  void step(const Model& model, State& state, std::vector<Wrench>& wrenches, std::vector<int>& points);
+  // pairs' friction anchors in `state.pairs`. Allocation-free for pairs of polyhedra. With
+  // `records`, each point of a pair with an awake body is also appended to it with its force on
+  // b (no allocation once it has held the most points of the run).
+  void step(const Model& model, State& state, std::vector<Wrench>& wrenches, std::vector<int>& points,
+            std::vector<ContactRecord>* records = nullptr);
 
   // The same contact points and anchors for the implicit step: each point appended to `out` as a
   // coupling (a < b, the normal from a towards b, the law unclamped), nothing summed.
@@ -96,7 +102,7 @@ class BodyContacts {
 
  private:
   void run(const Model& model, State& state, std::vector<Wrench>* wrenches, std::vector<int>& points,
-           std::vector<Coupling>* out);
+           std::vector<Coupling>* out, std::vector<ContactRecord>* records);
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };

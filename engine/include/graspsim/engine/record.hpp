@@ -55,6 +55,17 @@ struct BodyRecord {
                                           //      the quasi-static gravity drop
 };
 
+// One contact point of the bodies at a physics step: a floor point or a body-body point, with the
+// force the step applied there (paper: the clamped spring-damper; implicit: the solved force at
+// the end of the step).
+struct ContactRecord {
+  int a = kFloor;                    // body pushed by -force (of a pair, the lower index), or kFloor
+  int b = 0;                         // body pushed by +force
+  Vec3 point{0.0, 0.0, 0.0};         // m, world: where the force acts
+  Vec3 normal{0.0, 0.0, 1.0};        // 1, world, unit: from a towards b (the floor's points up)
+  Vec3 force{0.0, 0.0, 0.0};         // N, world: on b (-force on a)
+};
+
 struct TickRecord {
   std::int64_t tick = 0;   // servo tick this record belongs to
   bool haptic_ran = false;
@@ -62,6 +73,12 @@ struct TickRecord {
   std::vector<ServoFingerRecord> servo;     // per finger, every tick
   std::vector<HapticFingerRecord> haptic;   // per finger, valid when haptic_ran
   std::vector<BodyRecord> physics;          // per body, valid when physics_ran
+  std::vector<ContactRecord> contacts;      // valid when physics_ran, filled only when the
+                                            // Simulation records contacts (record_contacts): the contact points of the
+                                            // awake bodies in the step's order (the count of
+                                            // each kind per body is BodyRecord's), cleared and
+                                            // refilled each physics step: no allocation once
+                                            // it has held the most points of the run
   int diverged_body = -1;                   // first body whose state this tick is not finite or
                                             // faster than kDivergedSpeed / kDivergedAngularSpeed
                                             // (the integration diverged), else -1

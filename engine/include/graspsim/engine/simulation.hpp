@@ -63,6 +63,11 @@ class Simulation {
   const Model& model() const { return model_; }
   const State& state() const { return state_; }
   const Divisors& divisors() const { return divisors_; }
+  // Whether the physics stage lists its contact points in TickRecord::contacts (off: the list
+  // stays empty, and the step skips the copies, 2 to 3 % of a resting box's step). Off by
+  // default; the run loop turns it on when a trace records /contacts. Changes no result.
+  void record_contacts(bool on) { record_contacts_ = on; }
+  bool records_contacts() const { return record_contacts_; }
   std::int64_t tick() const { return state_.tick; }
   double time() const { return static_cast<double>(state_.tick) / model_.rates.servo; }   // s
 
@@ -74,10 +79,11 @@ class Simulation {
   // The physics stage's parts.
   double gimbal_pitch_change(const Input& input);
   void wake_touched_bodies();
-  void paper_contacts();
+  void paper_contacts(TickRecord& record);
   void paper_body_step(int b, double pitch_change, TickRecord& record);
   void implicit_contacts(const Input& input);
   void implicit_solve(double pitch_change);
+  void record_implicit_contacts(TickRecord& record) const;
   void implicit_body_step(int b, TickRecord& record);
   void record_sleeping(int b, TickRecord& record);
   BodyRecord& record_state(int b, int floor_contacts, TickRecord& record);
@@ -87,6 +93,7 @@ class Simulation {
   void finish_body_step(int b, TickRecord& record);
 
   Model model_;
+  bool record_contacts_ = false;
   Divisors divisors_;
   State state_;
   // Servo ticks until the haptic and the physics loops next run (0: at this tick): the clock's

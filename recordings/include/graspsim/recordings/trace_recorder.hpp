@@ -30,9 +30,9 @@ struct RowSize {
 class TraceRecorder {
  public:
   // The rows the constructor declares for `model`, for estimates before a run (the memory a
-  // writer holds, the disk a trace takes): /servo, /haptic, /physics.
+  // writer holds, the disk a trace takes): /servo, /haptic, /physics, and one /contacts row.
   struct Rows {
-    RowSize servo, haptic, physics;
+    RowSize servo, haptic, physics, contacts;
   };
   static Rows row_sizes(const graspsim::Model& model);
 
@@ -48,7 +48,8 @@ class TraceRecorder {
                 const RecordSelection& select = {});
 
   // Appends one /servo row, plus a /haptic row if rec.haptic_ran and a /physics row if
-  // rec.physics_ran, each only if its loop is recorded and this is one of its kept ticks. `rendered` (one per finger): the force each device actually rendered after
+  // rec.physics_ran, each only if its loop is recorded and this is one of its kept ticks, and
+  // at a kept physics tick of /contacts one /contacts row per rec.contacts entry. `rendered` (one per finger): the force each device actually rendered after
   // clamping (N, world). `input`: the device input the step was given (its gimbal angles go to
   // /servo, so the trace alone can replay the run). `after`: the State after the step, whose
   // state_hash goes to /physics/state_hash. time = tick / servo rate, computed from the tick,
@@ -62,15 +63,17 @@ class TraceRecorder {
   TraceTable* servo_;     // null: the loop is not recorded
   TraceTable* haptic_;
   TraceTable* physics_;
+  TraceTable* contacts_;
   double servo_rate_;   // Hz
   // Decimation (RecordSelection::every): ticks of each loop to its next kept row, a countdown
   // rather than a division per tick.
-  std::int64_t servo_every_, haptic_every_, physics_every_;
-  std::int64_t servo_wait_ = 0, haptic_wait_ = 0, physics_wait_ = 0;
+  std::int64_t servo_every_, haptic_every_, physics_every_, contacts_every_;
+  std::int64_t servo_wait_ = 0, haptic_wait_ = 0, physics_wait_ = 0, contacts_wait_ = 0;
   // Offsets into a row of each record's first column; its fields follow it in table order
   // (trace_schema.hpp).
   std::size_t servo_loop_ = 0, haptic_loop_ = 0, physics_loop_ = 0;   // tick, time
   std::size_t physics_hash_ = 0;                                      // state_hash
+  std::size_t contacts_loop_ = 0, contact_fields_ = 0;                // tick, time; a, b, ...
   std::vector<std::size_t> servo_fingers_;    // Model::fingers order
   std::vector<std::size_t> haptic_fingers_;   // Model::fingers order
   std::vector<std::size_t> objects_;          // Model::bodies order

@@ -154,6 +154,7 @@ inline constexpr std::string_view kDevices = "devices/";   // + <finger>
 inline constexpr std::string_view kServo = "servo";        // every servo tick
 inline constexpr std::string_view kHaptic = "haptic";      // every haptic tick
 inline constexpr std::string_view kPhysics = "physics";    // every physics tick
+inline constexpr std::string_view kContacts = "contacts";  // a row per contact point per physics tick
 inline constexpr std::string_view kFingers = "fingers/";   // + <finger>/ + field
 inline constexpr std::string_view kObjects = "objects/";   // + <object>/ + field
 
@@ -198,6 +199,15 @@ inline constexpr Field<BodyRecord> kBodyFields[] = {
     field<&BodyRecord::grasp_area>("grasp_area", "m^2"),
     field<&BodyRecord::torsion>("torsion", "N m"),
     field<&BodyRecord::twist>("twist", "rad"),
+};
+
+// /contacts after tick and time: one row per floor or body-body point of a physics step.
+inline constexpr Field<ContactRecord> kContactFields[] = {
+    field<&ContactRecord::a>("a", "1", {"values", "-2 floor, k = objects[k]"}),
+    field<&ContactRecord::b>("b", "1", {"values", "k = objects[k]"}),
+    field<&ContactRecord::point>("point", "m"),
+    field<&ContactRecord::normal>("normal", "1"),
+    field<&ContactRecord::force>("force", "N"),
 };
 
 inline constexpr Field<DeviceRow> kDeviceFields[] = {
