@@ -6,12 +6,14 @@
 
 #include <httplib.h>
 
+#include <atomic>
 #include <chrono>
 #include <condition_variable>
 #include <cstdio>
 #include <mutex>
 #include <thread>
 
+#include "view/server/http.hpp"
 #include "view/server/pack.hpp"
 #include "view/server/scene.hpp"
 
@@ -91,6 +93,7 @@ struct LiveServer::Impl {
   std::string scene_json;
   int port = 0;
   std::thread server, pump;
+  std::atomic<bool> listen_returned{false};   // the server thread's listen has returned
 
   std::mutex mutex;                 // guards what follows, between the pump and the streams
   std::condition_variable changed;
@@ -206,7 +209,15 @@ LiveServer::LiveServer(const scripting::Scenario& scenario, app::LiveChannel& ch
                       " (the port is in use, or needs privileges): choose another with --port N, or --port 0 for any free one");
     im.port = port;
   }
-  im.server = std::thread([&im] { im.http.listen_after_bind(); });
+  im.server = std::thread([&im] { listen_marking(im.http, im.listen_returned); });
+  // s: how long the listening thread may take to start before the view is given up.
+  constexpr double kStartLimit = 2.0;
+  if (!wait_running(http, im.listen_returned, kStartLimit)) {
+    stop_until_returned(http, im.listen_returned);
+    im.server.join();
+    throw ViewError("cannot serve on 127.0.0.1:" + std::to_string(im.port) + ": the server did not start within " +
+                    std::to_string(static_cast<int>(kStartLimit)) + " s");
+  }
   im.pump = std::thread([&im] { im.run_pump(); });
 }
 
@@ -238,7 +249,7 @@ LiveServer::~LiveServer() {
     im.changed.notify_all();
   }
   if (im.pump.joinable()) im.pump.join();
-  im.http.stop();
+  stop_until_returned(im.http, im.listen_returned);
   if (im.server.joinable()) im.server.join();
 }
 

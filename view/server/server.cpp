@@ -1,7 +1,7 @@
 // cpp-httplib serving the page, /scene.json and /trace.bin.
 #include "view/server/server.hpp"
 
-#include <httplib.h>
+#include "view/server/http.hpp"
 
 #include <cstdlib>
 #include <filesystem>
@@ -25,6 +25,7 @@ struct ViewServer::Impl {
   Packed packed;
   Packed overlay;            // the second run of `graspsim view A B`
   std::string compare;       // /compare.json
+  std::atomic<bool> listen_returned{false};   // serve() has returned
 };
 
 ViewServer::ViewServer(Packed packed, std::string web, int port) : impl_(std::make_unique<Impl>()) {
@@ -86,8 +87,8 @@ void ViewServer::add_overlay(Packed b, std::string compare_json) {
 
 ViewServer::~ViewServer() = default;
 
-bool ViewServer::serve() { return impl_->http.listen_after_bind(); }
+bool ViewServer::serve() { return listen_marking(impl_->http, impl_->listen_returned); }
 
-void ViewServer::stop() { impl_->http.stop(); }
+void ViewServer::stop() { stop_until_returned(impl_->http, impl_->listen_returned); }
 
 }  // namespace graspsim::view
