@@ -54,19 +54,33 @@ std::string run_slurm(const std::string& program, const Plan& plan, const std::s
   std::fprintf(stderr, "graspsim sweep: submitted %zu runs as Slurm job array %s (%s)\n", pending.size(), job.c_str(),
                script.c_str());
   std::size_t reported = 0;
+  constexpr int kSqueueTries = 120;   // 60 s of failed squeue at one poll per 0.5 s
+  int failures = 0;                   // squeue failures in a row
   for (;;) {
     if (stop.load()) {
       std::system(("scancel " + job).c_str());
       return "stopped: cancelled job " + job;
     }
-    FILE* q = popen(("squeue -h -j " + job + " -o %i 2>/dev/null").c_str(), "r");
+    // Empty output means the array has left the queue only when squeue answered (exit 0); a job
+    // id the controller has already forgotten is ended too. Any other failure (the controller
+    // down or restarting) is retried, up to kSqueueTries in a row.
+    FILE* q = popen(("squeue -h -j " + job + " -o %i 2>&1").c_str(), "r");
     std::string queued;
     while (q && std::fgets(buf, sizeof buf, q)) queued += buf;
-    if (q) pclose(q);
+    const int squeue_status = q ? pclose(q) : -1;
     std::size_t done = 0;
     for (const std::size_t i : pending) done += read_row(plan, dir, i).has_value();
     if (done != reported) progress(reported = done, pending.size());
-    if (queued.find_first_not_of(" \n") == std::string::npos) return {};
+    if (squeue_status == 0) {
+      failures = 0;
+      if (queued.find_first_not_of(" \n") == std::string::npos) return {};
+    } else if (queued.find("Invalid job id") != std::string::npos) {
+      return {};
+    } else if (++failures >= kSqueueTries) {
+      return "squeue failed " + std::to_string(failures) + " times in a row while job " + job +
+             " may still run (its runs' rows are kept; rerun with --resume once Slurm answers): " +
+             (queued.empty() ? "no output" : queued.substr(0, queued.find_last_not_of(" \n") + 1));
+    }
     std::this_thread::sleep_for(std::chrono::milliseconds(500));
   }
 }
