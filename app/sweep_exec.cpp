@@ -1,6 +1,8 @@
 // Running a sweep's runs as child processes (sweep_exec.hpp).
 #include "app/sweep_exec.hpp"
 
+#include "app/output_file.hpp"
+
 #include <cerrno>
 #include <chrono>
 #include <csignal>
@@ -17,6 +19,13 @@ extern char** environ;
 
 namespace graspsim::app::sweep {
 
+bool clear_stale_partial(const Plan& plan, const std::string& dir, std::size_t index) {
+  const std::string partial = partial_name(plan.run_file(dir, index, "h5"));
+  std::error_code ec;
+  if (!std::filesystem::exists(partial, ec) || locked_by_a_run(partial)) return false;
+  return std::filesystem::remove(partial, ec);
+}
+
 pid_t start_run(const std::string& program, const Plan& plan, const std::string& dir, std::size_t index) {
   const std::vector<std::string> args = plan.run_arguments(index, dir);
   std::vector<char*> argv{const_cast<char*>(program.c_str())};
@@ -24,6 +33,7 @@ pid_t start_run(const std::string& program, const Plan& plan, const std::string&
   argv.push_back(nullptr);
   const std::string log = plan.run_file(dir, index, "log");
   std::remove(plan.run_file(dir, index, "summary").c_str());   // a stopped run's, if any
+  if (plan.keep_traces) clear_stale_partial(plan, dir, index);
   posix_spawn_file_actions_t actions;
   posix_spawn_file_actions_init(&actions);
   posix_spawn_file_actions_addopen(&actions, STDIN_FILENO, "/dev/null", O_RDONLY, 0);

@@ -14,7 +14,12 @@
 
 namespace graspsim::app::sweep {
 
-// Starts run `index` of `plan` as a child process of `graspsim` (the executable `program`);
+// Removes run `index`'s partial trace (runs/<index>.h5.partial) unless a live run holds its lock:
+// one left by a run that was killed would make the rerun refuse its --out. The sweep owns runs/.
+// Returns true when one was removed.
+bool clear_stale_partial(const Plan& plan, const std::string& dir, std::size_t index);
+
+// Starts run `index` of `plan` (its stale partial trace removed first) as a child process of `graspsim` (the executable `program`);
 // throws SweepError when it cannot be started.
 pid_t start_run(const std::string& program, const Plan& plan, const std::string& dir, std::size_t index);
 
