@@ -13,6 +13,7 @@
 #include <sstream>
 #include <spawn.h>
 #include <sys/wait.h>
+#include <thread>
 #include <unistd.h>
 
 extern char** environ;
@@ -81,37 +82,64 @@ std::vector<std::size_t> pending_runs(const Plan& plan, const std::string& dir) 
   return out;
 }
 
+namespace {
+
+// Ends every run in `running` (SIGTERM) and waits for each: none is left running or unreaped.
+template <class Running>
+void end_all(Running& running) {
+  for (const auto& [pid, run] : running) kill(pid, SIGTERM);
+  for (const auto& [pid, run] : running) {
+    int status = 0;
+    while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+    }
+  }
+  running.clear();
+}
+
+}  // namespace
+
 bool run_local(const std::string& program, const Plan& plan, const std::string& dir,
                const std::vector<std::size_t>& indices, int jobs, const std::atomic<bool>& stop,
                const std::function<void(std::size_t, std::size_t)>& done) {
   using Clock = std::chrono::steady_clock;
+  // How long the loop sleeps when no run has ended; `stop` is seen within it, whatever the runs do.
+  constexpr auto kPoll = std::chrono::milliseconds(10);
   std::map<pid_t, std::pair<std::size_t, Clock::time_point>> running;
   std::size_t next = 0, finished = 0;
   bool stopping = false;
-  while (next < indices.size() || !running.empty()) {
-    if (stop.load() && !stopping) {   // stop every run; their rows are not written
-      stopping = true;
-      for (const auto& [pid, run] : running) kill(pid, SIGTERM);
+  try {
+    while (next < indices.size() || !running.empty()) {
+      if (stop.load() && !stopping) {   // stop every run; their rows are not written
+        stopping = true;
+        for (const auto& [pid, run] : running) kill(pid, SIGTERM);
+      }
+      while (!stopping && next < indices.size() && static_cast<int>(running.size()) < jobs) {
+        const std::size_t index = indices[next++];
+        running[start_run(program, plan, dir, index)] = {index, Clock::now()};
+      }
+      if (running.empty()) break;
+      int status = 0;
+      const pid_t pid = waitpid(-1, &status, WNOHANG);
+      if (pid == 0) {   // none ended yet
+        std::this_thread::sleep_for(kPoll);
+        continue;
+      }
+      if (pid < 0) {
+        if (errno == EINTR) continue;   // a signal: the loop's top sees `stop`
+        throw SweepError(std::string("waiting for a run: ") + std::strerror(errno));
+      }
+      const auto it = running.find(pid);
+      if (it == running.end()) continue;
+      const auto [index, start] = it->second;
+      running.erase(it);
+      const double wall = std::chrono::duration<double>(Clock::now() - start).count();
+      if (stopping) continue;
+      finish_run(plan, dir, index, status, wall);
+      if (done) done(++finished, indices.size());
     }
-    while (!stopping && next < indices.size() && static_cast<int>(running.size()) < jobs) {
-      const std::size_t index = indices[next++];
-      running[start_run(program, plan, dir, index)] = {index, Clock::now()};
-    }
-    if (running.empty()) break;
-    int status = 0;
-    const pid_t pid = waitpid(-1, &status, 0);
-    if (pid < 0) {
-      if (errno == EINTR) continue;   // a signal: the loop's top sees `stop`
-      throw SweepError(std::string("waiting for a run: ") + std::strerror(errno));
-    }
-    const auto it = running.find(pid);
-    if (it == running.end()) continue;
-    const auto [index, start] = it->second;
-    running.erase(it);
-    const double wall = std::chrono::duration<double>(Clock::now() - start).count();
-    if (stopping) continue;
-    finish_run(plan, dir, index, status, wall);
-    if (done) done(++finished, indices.size());
+  } catch (...) {   // no run outlives the sweep that started it
+    end_all(running);
+    throw;
   }
   return !stopping;
 }

@@ -1,6 +1,10 @@
 // The sweep's handling of its runs' files (app/sweep_exec.hpp), without running graspsim.
 #include <catch2/catch.hpp>
 
+#include <sys/wait.h>
+
+#include <atomic>
+#include <cerrno>
 #include <filesystem>
 #include <fstream>
 
@@ -33,4 +37,25 @@ TEST_CASE("a run's partial trace left by a killed run is removed before the reru
   CHECK_FALSE(sweep::clear_stale_partial(plan, dir.string(), 0));
   CHECK(fs::exists(live.partial()));
   live.abandon();
+}
+
+TEST_CASE("when the sweep's own bookkeeping throws, every run it started is stopped and reaped", "[sweep]") {
+  // A stand-in for graspsim: the run with mu=0.2 ends at once, the others sleep 30 s. The first
+  // run's end makes `done` throw; the sleeping runs must not outlive run_local (no child left to
+  // reap: waitpid says ECHILD), and the exception must reach the caller.
+  const fs::path dir = fs::path(GRASPSIM_TEST_TMP) / "sweep_throw_reaps";
+  fs::remove_all(dir);
+  fs::create_directories(dir / "runs");
+  const std::string program = (dir / "fake_graspsim.sh").string();
+  std::ofstream(program) << "#!/bin/sh\ncase \"$*\" in *mu=0.2*) exit 0;; *) exec sleep 30;; esac\n";
+  fs::permissions(program, fs::perms::owner_all);
+  sweep::Plan plan;
+  plan.scenario = "/s/lift.lua";
+  plan.grid = {{"mu", {"0.2", "0.6", "0.9"}}};
+  std::atomic<bool> stop{false};
+  const auto fail = [](std::size_t, std::size_t) { throw sweep::SweepError("the table could not be written"); };
+  CHECK_THROWS_AS(sweep::run_local(program, plan, dir.string(), {0, 1, 2}, 3, stop, fail), sweep::SweepError);
+  errno = 0;
+  CHECK(waitpid(-1, nullptr, WNOHANG) == -1);
+  CHECK(errno == ECHILD);
 }
