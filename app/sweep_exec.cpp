@@ -34,6 +34,7 @@ pid_t start_run(const std::string& program, const Plan& plan, const std::string&
   argv.push_back(nullptr);
   const std::string log = plan.run_file(dir, index, "log");
   std::remove(plan.run_file(dir, index, "summary").c_str());   // a stopped run's, if any
+  std::remove((plan.run_file(dir, index, "summary") + ".partial").c_str());   // a killed run's, if any
   if (plan.keep_traces) clear_stale_partial(plan, dir, index);
   posix_spawn_file_actions_t actions;
   posix_spawn_file_actions_init(&actions);

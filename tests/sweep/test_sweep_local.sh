@@ -92,7 +92,7 @@ refused "holds this sweep already" "$lift" "${sweep_grid[@]}" --out "$tmp/j1"
 # The runs' --summary may not be the scenario (it would be written over).
 cp "$lift" "$tmp/lift.lua"
 "$cli" run "$tmp/lift.lua" --no-trace --summary "$tmp/lift.lua" >"$tmp/bad.log" 2>&1
-[ $? -eq 2 ] && grep -q -- "--summary $tmp/lift.lua is the scenario" "$tmp/bad.log" && cmp -s "$lift" "$tmp/lift.lua" \
+[ $? -eq 2 ] && grep -q -- "--summary '$tmp/lift.lua' is the scenario" "$tmp/bad.log" && cmp -s "$lift" "$tmp/lift.lua" \
   || { cat "$tmp/bad.log"; fail "run --summary SCENARIO was not refused, or the scenario changed"; }
 echo "ok: refused: $(head -n1 "$tmp/bad.log")"
 [ ! -e "$tmp/bad" ] || fail "a refused sweep made $tmp/bad"
