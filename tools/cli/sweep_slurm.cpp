@@ -16,12 +16,6 @@ namespace graspsim::cli {
 namespace fs = std::filesystem;
 using namespace app::sweep;
 
-std::string shell_quote(const std::string& s) {
-  std::string out = "'";
-  for (const char c : s) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return out + "'";
-}
-
 std::string run_slurm(const std::string& program, const Plan& plan, const std::string& dir,
                       const std::vector<std::size_t>& pending,
                       const std::function<void(std::size_t, std::size_t)>& progress, const std::atomic<bool>& stop) {
@@ -32,16 +26,10 @@ std::string run_slurm(const std::string& program, const Plan& plan, const std::s
   const std::string script = (slurm / "job.sh").string();
   {
     std::ofstream out(script, std::ios::trunc);
-    out << "#!/bin/sh\n"
-        << "# One run of the graspsim sweep in " << dir << " per array task (graspsim sweep --slurm).\n"
-        << "#SBATCH --job-name=graspsim-sweep\n"
-        << "#SBATCH --ntasks=1\n"
-        << "#SBATCH --cpus-per-task=1\n"
-        << "#SBATCH --output=" << (slurm / "task-%a.out").string() << "\n"
-        << "exec " << shell_quote(program) << " sweep-task " << shell_quote(dir) << " \"$SLURM_ARRAY_TASK_ID\"\n";
+    out << slurm_job_script(program, dir);
     if (!out) return "cannot write " + script;
   }
-  const std::string submit = "sbatch --parsable --array=" + array_list(pending) + " " + shell_quote(script);
+  const std::string submit = sbatch_command(script, slurm.string(), array_list(pending));
   FILE* p = popen((submit + " 2>&1").c_str(), "r");
   if (!p) return "cannot run sbatch";
   std::string reply;
