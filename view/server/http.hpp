@@ -1,5 +1,5 @@
-// What the trace view's server and the live view's server share around cpp-httplib: a start and
-// a stop that do not race. Included by view/server's .cpp files
+// What the trace view's server and the live view's server share around cpp-httplib: the same
+// settings and bind, and a start and a stop that do not race. Included by view/server's .cpp files
 // only (it exposes httplib).
 #pragma once
 
@@ -9,6 +9,12 @@
 #include <string>
 
 namespace graspsim::view {
+
+// Sets what both servers serve alike (the page's files from `web`, .js as a type httplib does
+// not compress, an empty /favicon.ico, 1 s keep-alive, SO_REUSEADDR without SO_REUSEPORT) and
+// binds 127.0.0.1:`port` (0: any free port). Returns the port bound; throws ViewError naming the
+// port, and what to do, when it cannot be bound.
+int configure_and_bind(httplib::Server& http, const std::string& web, int port);
 
 // Runs listen_after_bind() on the calling thread and sets `returned` once it has returned.
 bool listen_marking(httplib::Server& http, std::atomic<bool>& returned);

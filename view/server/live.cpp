@@ -190,25 +190,7 @@ LiveServer::LiveServer(const scripting::Scenario& scenario, app::LiveChannel& ch
           im.changed.notify_all();
         });
   });
-  http.Get("/favicon.ico", [](const httplib::Request&, httplib::Response& res) { res.status = 204; });
-  http.set_keep_alive_timeout(1);
-  // As ViewServer (server.cpp): .js as a type httplib does not brotli-compress, and
-  // SO_REUSEADDR without SO_REUSEPORT, so a port another server listens on is refused.
-  http.set_file_extension_and_mimetype_mapping("js", "application/x-javascript");
-  http.set_mount_point("/", web);
-  http.set_socket_options([](socket_t sock) {
-    int yes = 1;
-    setsockopt(sock, SOL_SOCKET, SO_REUSEADDR, &yes, sizeof yes);
-  });
-  if (port == 0) {
-    im.port = http.bind_to_any_port("127.0.0.1");
-    if (im.port <= 0) throw ViewError("cannot listen on 127.0.0.1: no free port");
-  } else {
-    if (!http.bind_to_port("127.0.0.1", port))
-      throw ViewError("cannot listen on 127.0.0.1:" + std::to_string(port) +
-                      " (the port is in use, or needs privileges): choose another with --port N, or --port 0 for any free one");
-    im.port = port;
-  }
+  im.port = configure_and_bind(http, web, port);
   im.server = std::thread([&im] { listen_marking(im.http, im.listen_returned); });
   // s: how long the listening thread may take to start before the view is given up.
   constexpr double kStartLimit = 2.0;
