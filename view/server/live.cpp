@@ -210,9 +210,6 @@ void LiveServer::end(const LiveEnd& end, double wait_s) {
   {
     std::lock_guard<std::mutex> lock(im.mutex);
     if (!im.end_message.empty() || im.stopping) return;
-  }
-  {
-    std::lock_guard<std::mutex> lock(im.mutex);
     im.pump_done = true;
   }
   if (im.pump.joinable()) im.pump.join();
