@@ -42,8 +42,11 @@ std::string run_slurm(const std::string& program, const Plan& plan, const std::s
   std::fprintf(stderr, "graspsim sweep: submitted %zu runs as Slurm job array %s (%s)\n", pending.size(), job.c_str(),
                script.c_str());
   std::size_t reported = 0;
-  constexpr int kSqueueTries = 120;   // 60 s of failed squeue at one poll per 0.5 s
-  int failures = 0;                   // squeue failures in a row
+  // s: how long squeue may fail in a row (each failure can itself take seconds: it retries the
+  // controller) before the sweep gives up waiting.
+  constexpr double kSqueueFailing = 60.0;
+  int failures = 0;                                  // squeue failures in a row
+  std::chrono::steady_clock::time_point failing_since;
   for (;;) {
     if (stop.load()) {
       std::system(("scancel " + job).c_str());
@@ -51,7 +54,7 @@ std::string run_slurm(const std::string& program, const Plan& plan, const std::s
     }
     // Empty output means the array has left the queue only when squeue answered (exit 0); a job
     // id the controller has already forgotten is ended too. Any other failure (the controller
-    // down or restarting) is retried, up to kSqueueTries in a row.
+    // down or restarting) is retried for up to kSqueueFailing seconds in a row.
     FILE* q = popen(("squeue -h -j " + job + " -o %i 2>&1").c_str(), "r");
     std::string queued;
     while (q && std::fgets(buf, sizeof buf, q)) queued += buf;
@@ -64,8 +67,11 @@ std::string run_slurm(const std::string& program, const Plan& plan, const std::s
       if (queued.find_first_not_of(" \n") == std::string::npos) return {};
     } else if (queued.find("Invalid job id") != std::string::npos) {
       return {};
-    } else if (++failures >= kSqueueTries) {
-      return "squeue failed " + std::to_string(failures) + " times in a row while job " + job +
+    } else if (++failures == 1) {
+      failing_since = std::chrono::steady_clock::now();
+    } else if (std::chrono::duration<double>(std::chrono::steady_clock::now() - failing_since).count() > kSqueueFailing) {
+      return "squeue failed " + std::to_string(failures) + " times in a row (" +
+             std::to_string(static_cast<int>(kSqueueFailing)) + " s) while job " + job +
              " may still run (its runs' rows are kept; rerun with --resume once Slurm answers): " +
              (queued.empty() ? "no output" : queued.substr(0, queued.find_last_not_of(" \n") + 1));
     }
