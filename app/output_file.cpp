@@ -44,16 +44,16 @@ std::string default_trace_name(const std::string& scenario_name) {
 
 std::string partial_name(const std::string& out) { return out + ".partial"; }
 
-void refuse_input_as_output(const std::string& out, const std::vector<InputFile>& inputs) {
+void refuse_input_as_output(const std::string& out, const std::vector<InputFile>& inputs, const std::string& flag) {
   const std::string partial = partial_name(out);
   for (const InputFile& input : inputs) {
     if (same_path(out, input.path)) {
-      throw OutputError("--out " + in_quotes(out) + " is " + input.what + " (" + in_quotes(input.path) +
-                        "), an input of this run: it would be written over; choose another output");
+      throw OutputError(flag + " " + in_quotes(out) + " is " + input.what + " (" + in_quotes(input.path) +
+                        "), a file this run reads or writes: it would be written over; choose another output");
     }
     if (same_path(partial, input.path)) {
-      throw OutputError("--out " + in_quotes(out) + " is written as " + in_quotes(partial) + " until the run ends, and that is " +
-                        input.what + " (" + in_quotes(input.path) + "), an input of this run; choose another output");
+      throw OutputError(flag + " " + in_quotes(out) + " is written as " + in_quotes(partial) + " until the run ends, and that is " +
+                        input.what + " (" + in_quotes(input.path) + "), a file this run reads or writes; choose another output");
     }
   }
 }

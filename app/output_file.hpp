@@ -38,8 +38,9 @@ std::string partial_name(const std::string& out);
 
 // Throws OutputError if `out`, or the partial name it is written under, is one of `inputs`:
 // the same name, or the same file (device and inode, symbolic links followed, so a link or a
-// hard link to an input is refused too).
-void refuse_input_as_output(const std::string& out, const std::vector<InputFile>& inputs);
+// hard link to an input is refused too). The message names `out` as the option `flag` gave it.
+void refuse_input_as_output(const std::string& out, const std::vector<InputFile>& inputs,
+                            const std::string& flag = "--out");
 
 // True when a run holds the lock of an OutputClaim on `path` (its partial trace is being
 // written): such a file must not be repaired or written by anyone else.

@@ -11,6 +11,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "graspsim/engine/math.hpp"
 #include "graspsim/hw/device.hpp"
 #include "graspsim/hw/trajectory.hpp"
 

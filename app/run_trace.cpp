@@ -51,6 +51,13 @@ std::int64_t flush_interval_ticks(const Model& model) {
   return period <= limit ? limit / period * period : limit;
 }
 
+std::vector<InputFile> run_inputs(const scripting::Scenario& scenario, const RunOptions& options) {
+  std::vector<InputFile> inputs = options.inputs;
+  inputs.push_back({scenario.path(), "the scenario"});
+  for (const std::string& f : scenario.files()) inputs.push_back({f, "a mesh file of the scenario"});
+  return inputs;
+}
+
 RunTrace::RunTrace(const scripting::Scenario& scenario, const RunOptions& options)
     : path_(options.out.empty() ? default_trace_name(scenario.name()) : options.out),
       record_(options.trace.record) {
@@ -60,10 +67,7 @@ RunTrace::RunTrace(const scripting::Scenario& scenario, const RunOptions& option
   }
   try {
     if (options.trace.write) {
-      std::vector<InputFile> inputs = options.inputs;
-      inputs.push_back({scenario.path(), "the scenario"});
-      for (const std::string& f : scenario.files()) inputs.push_back({f, "a mesh file of the scenario"});
-      refuse_input_as_output(path_, inputs);   // throws OutputError
+      refuse_input_as_output(path_, run_inputs(scenario, options));   // throws OutputError
       claim_.emplace(path_);                   // throws OutputError
       recordings::TraceOptions trace_options;
       if (options.trace.block_rows > 0) trace_options.block_rows = options.trace.block_rows;

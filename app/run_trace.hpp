@@ -19,6 +19,10 @@ namespace graspsim::app {
 
 using RunClock = std::chrono::steady_clock;
 
+// The files a run of `scenario` reads, none of which it may write: `options.inputs` (the devices'
+// files), the scenario and its mesh files.
+std::vector<InputFile> run_inputs(const scripting::Scenario& scenario, const RunOptions& options);
+
 // Crash safety (recordings/README.md): a run killed at any moment loses less than kFlushSimulated
 // of simulated time, however far the writer thread lags. The trace is flushed every flush
 // interval (at most kFlushSimulated / (kFlushesInFlight + 1) of simulated time), and before a

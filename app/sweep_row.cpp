@@ -1,7 +1,12 @@
 // A sweep's rows and the run summaries they are made from (sweep_row.hpp).
 #include "app/sweep_row.hpp"
 
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <cerrno>
 #include <cstdio>
+#include <cstring>
 #include <fstream>
 #include <sstream>
 
@@ -98,6 +103,32 @@ std::optional<Row> read_row(const Plan& plan, const std::string& dir, std::size_
   const Plan::Run r = plan.run(index);
   if (row.index != index || row.values != r.values || row.seed != r.seed) return std::nullopt;
   return row;
+}
+
+std::string write_summary(const std::string& path, const std::string& text) {
+  const std::string partial = path + ".partial";
+  const int fd = open(partial.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
+  if (fd < 0) {
+    const int e = errno;
+    return "cannot create " + partial + ": " + std::strerror(e) +
+           (e == EEXIST ? " (a file of that name is there and is kept: move it away)" : "");
+  }
+  std::size_t at = 0;
+  int error = 0;
+  while (at < text.size()) {
+    const ssize_t n = write(fd, text.data() + at, text.size() - at);
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0) {
+      error = errno;
+      break;
+    }
+    at += static_cast<std::size_t>(n);
+  }
+  if (close(fd) != 0 && !error) error = errno;
+  if (!error && std::rename(partial.c_str(), path.c_str()) != 0) error = errno;
+  if (!error) return "";
+  unlink(partial.c_str());
+  return "cannot write " + path + ": " + std::strerror(error);
 }
 
 }  // namespace graspsim::app::sweep

@@ -34,6 +34,11 @@ struct Row {
 std::string summary_text(const std::vector<scripting::ExpectationResult>& expectations);
 std::vector<Expectation> parse_summary(const std::string& text);
 
+// Writes `text` to `path` whole: into "<path>.partial", created new (O_EXCL: a file of that name
+// already there is never truncated nor removed), then renamed over `path`. Returns "" or why not
+// (the file and strerror); on failure the partial it created is removed.
+std::string write_summary(const std::string& path, const std::string& text);
+
 std::string row_text(const Row& row);
 Row parse_row(const std::string& text, const std::string& file);   // throws SweepError
 

@@ -35,14 +35,16 @@ install(TARGETS graspsim RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
 # except the schema-free HDF5 inspector (h5_inspect.hpp: its library, graspsim_recordings_inspect,
 # is for tests and tools in this tree). Of app/, what a program needs to run a scenario the way
 # the CLI does: run.hpp (and the three it includes), devices (--device), run_budget (the size check
-# before a run) and replay. The rest of app/ is the run's inside and the CLI's report.
+# before a run) and replay; session.hpp, a run stepped one tick at a time by the program that holds
+# it, and program_finger.hpp, a finger that program moves as a device would. The rest of app/ is
+# the run's inside and the CLI's report.
 foreach(module engine hw recordings scripting)
   install(DIRECTORY ${PROJECT_SOURCE_DIR}/${module}/include/
           DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}
           FILES_MATCHING PATTERN "*.hpp" PATTERN "h5_inspect.hpp" EXCLUDE)
 endforeach()
 set(graspsim_app_public_headers run.hpp output_file.hpp pacer.hpp live_channel.hpp devices.hpp run_budget.hpp
-  replay.hpp)
+  replay.hpp session.hpp program_finger.hpp)
 list(TRANSFORM graspsim_app_public_headers PREPEND ${PROJECT_SOURCE_DIR}/app/)
 install(FILES ${graspsim_app_public_headers} DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/graspsim/app)
 

@@ -1,11 +1,15 @@
-// A program that embeds graspsim: loads a scenario, runs it to its end writing its trace, and
-// reports its expectations. Its trace equals `graspsim run SCENARIO --out OUT` bit for bit.
+// A program that embeds graspsim: loads a scenario, steps its run tick by tick to the end writing
+// its trace (app::RunSession, as an application that acts between ticks would), and reports its
+// expectations. Its trace equals `graspsim run SCENARIO --out OUT` bit for bit.
 // usage: graspsim_consumer SCENARIO.lua OUT.h5
 // exit status: 0 every expectation held, 1 one failed or the run stopped early, 2 bad input.
 #include <cstdio>
 #include <exception>
 #include <string>
 
+// session.hpp first: the install test builds this file, so the header is checked to compile alone.
+#include <graspsim/app/session.hpp>
+//
 #include <graspsim/app/run.hpp>
 #include <graspsim/engine/build_config.hpp>
 #include <graspsim/recordings/trace_writer.hpp>
@@ -27,7 +31,11 @@ int main(int argc, char** argv) {
     const graspsim::scripting::Scenario scenario = graspsim::scripting::Scenario::load(scenario_path);
     graspsim::app::RunOptions options;   // the defaults: scripted fingers, every tick of every loop
     options.out = out;
-    const graspsim::app::RunResult result = graspsim::app::run_scenario(scenario, options);
+    graspsim::app::RunSession session(scenario, options);
+    while (session.step()) {
+      // An application reads session.simulation() or session.record() here, between ticks.
+    }
+    const graspsim::app::RunResult result = session.finish();
     if (result.not_started) {
       std::fprintf(stderr, "graspsim_consumer: %s: the run could not start: %s\n", scenario_path.c_str(),
                    result.error.c_str());

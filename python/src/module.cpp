@@ -53,11 +53,16 @@ Vec3 to_vec3(const py::handle& x, const char* what) {
 }
 
 // One `set` value as --set takes it: text as given, a number in full (repr: the shortest text
-// that reads back as the same double), a sequence of numbers joined by commas (gravity=0,0,-9.81).
+// that reads back as the same double; an integer exactly), a sequence of numbers joined by commas (gravity=0,0,-9.81).
 std::string set_value(const py::handle& v, const std::string& name) {
   if (py::isinstance<py::str>(v)) return v.cast<std::string>();
   if (py::isinstance<py::bool_>(v)) return v.cast<bool>() ? "true" : "false";
-  if (py::isinstance<py::int_>(v) || py::isinstance<py::float_>(v)) return py::repr(v).cast<std::string>();
+  // Any integral or real number (numpy's scalars too, whose repr under numpy 2 is
+  // "np.float64(0.5)") as a Python int or float first: repr of those is plain digits.
+  const py::module_ numbers = py::module_::import("numbers");
+  const py::module_ builtins = py::module_::import("builtins");   // int(), float(): exact types, even of a subclass
+  if (py::isinstance(v, numbers.attr("Integral"))) return py::repr(builtins.attr("int")(v)).cast<std::string>();
+  if (py::isinstance(v, numbers.attr("Real"))) return py::repr(builtins.attr("float")(v)).cast<std::string>();
   if (py::isinstance<py::sequence>(v)) {
     std::string s;
     for (const auto& x : v.cast<py::sequence>()) s += (s.empty() ? "" : ",") + set_value(x, name);
@@ -141,12 +146,27 @@ void raise_if_failed(Session& s) {
 
 namespace {
 
+// The session, refused while step() or run() runs in another Python thread (Session::busy).
+template <typename S>
+S& idle(S& s) {
+  if (s.busy) throw std::runtime_error("session is busy: step() or run() is running in another thread");
+  return s;
+}
+
+// Marks the session busy for a scope (with the GIL held at both ends).
+struct BusyScope {
+  Session& s;
+  explicit BusyScope(Session& session) : s(idle(session)) { s.busy = true; }
+  ~BusyScope() { s.busy = false; }
+};
+
 // Steps up to n ticks, with the GIL released, Ctrl-C seen every kSignalTicks ticks (between two
 // ticks: the session stays usable). Returns the ticks run.
 constexpr std::int64_t kSignalTicks = 3000;
 std::int64_t step_ticks(Session& s, std::int64_t n) {
   if (n < 0) throw py::value_error("step(n): n is a number of servo ticks >= 0, got " + std::to_string(n));
   std::int64_t done = 0;
+  const BusyScope busy(s);
   while (done < n) {
     const std::int64_t chunk = std::min(kSignalTicks, n - done);
     std::int64_t ran = 0;
@@ -163,6 +183,7 @@ std::int64_t step_ticks(Session& s, std::int64_t n) {
 }
 
 py::dict state_dict(const Session& s) {
+  idle(s);
   const graspsim::Simulation& sim = s.run().simulation();
   const graspsim::State& st = sim.state();
   const std::size_t nb = st.bodies.size();
@@ -199,6 +220,7 @@ py::dict state_dict(const Session& s) {
 }
 
 py::dict records_dict(const Session& s) {
+  idle(s);
   const graspsim::TickRecord& r = s.run().record();
   const graspsim::Input& in = s.run().input();
   const std::size_t nf = r.servo.size(), nb = r.physics.size();
@@ -286,23 +308,23 @@ PYBIND11_MODULE(graspsim, m) {
       .def(
           "run",
           [](Session& s) {
-            step_ticks(s, s.run().ticks() - s.run().tick());
+            step_ticks(s, idle(s).run().ticks() - s.run().tick());
             return result_dict(s.run().finish());
           },
           "Runs to the end, checks the expectations due there, finishes the trace; returns the result")
       .def(
-          "finish", [](Session& s) { return result_dict(s.run().finish()); },
+          "finish", [](Session& s) { return result_dict(idle(s).run().finish()); },
           "Ends the run at this tick (expectations due later: not checked), finishes the trace; "
           "returns the result. Later calls return the same result.")
       .def("__enter__", [](Session& s) -> Session& { return s; })
-      .def("__exit__", [](Session& s, py::args) { s.run().finish(); })
-      .def_property_readonly("tick", [](const Session& s) { return s.run().tick(); },
+      .def("__exit__", [](Session& s, py::args) { idle(s).run().finish(); })
+      .def_property_readonly("tick", [](const Session& s) { return idle(s).run().tick(); },
                              "servo ticks run so far (the next tick's number)")
-      .def_property_readonly("ticks", [](const Session& s) { return s.run().ticks(); },
+      .def_property_readonly("ticks", [](const Session& s) { return idle(s).run().ticks(); },
                              "servo ticks of the whole run (duration * servo rate)")
-      .def_property_readonly("time", [](const Session& s) { return s.run().simulation().time(); },
+      .def_property_readonly("time", [](const Session& s) { return idle(s).run().simulation().time(); },
                              "s: simulated time, tick / servo rate")
-      .def_property_readonly("done", [](const Session& s) { return s.run().done(); })
+      .def_property_readonly("done", [](const Session& s) { return idle(s).run().done(); })
       .def_property_readonly("duration", [](const Session& s) { return s.scenario().duration(); }, "s")
       .def_property_readonly("name", [](const Session& s) { return s.scenario().name(); })
       .def_property_readonly("rates",
@@ -326,7 +348,7 @@ PYBIND11_MODULE(graspsim, m) {
       .def(
           "hip",
           [](const Session& s, const std::string& finger) {
-            const Vec3 h = s.run().input().fingers.at(s.finger(finger)).hip;
+            const Vec3 h = idle(s).run().input().fingers.at(s.finger(finger)).hip;
             return vec3s(1, [&](std::size_t) { return h; }).attr("reshape")(3);
           },
           py::arg("finger"), "m, world: the finger's HIP as its device gave it at the last tick")
@@ -334,18 +356,18 @@ PYBIND11_MODULE(graspsim, m) {
           "set_hip",
           [](Session& s, const std::string& finger, const py::object& hip, const py::object& gimbal) {
             const Vec3 g = gimbal.is_none() ? Vec3::Zero() : to_vec3(gimbal, "gimbal");
-            s.driven(s.finger(finger)).set(to_vec3(hip, "hip"), g);
+            idle(s).driven(s.finger(finger)).set(to_vec3(hip, "hip"), g);
           },
           py::arg("finger"), py::arg("hip"), py::arg("gimbal") = py::none(),
           "Sets a driven finger's HIP (m, world) and gimbal angles (rad: roll, pitch, yaw; default 0) "
           "from the next tick on, as its device would; the finger must be in load(..., drive=[...])")
       .def(
-          "follow_trajectory", [](Session& s, const std::string& finger) { s.driven(s.finger(finger)).follow_trajectory(); },
+          "follow_trajectory", [](Session& s, const std::string& finger) { idle(s).driven(s.finger(finger)).follow_trajectory(); },
           py::arg("finger"), "Hands a driven finger back to its scenario trajectory from the next tick on")
       .def(
           "rendered_force",
           [](Session& s, const std::string& finger) {
-            const Vec3 f = s.driven(s.finger(finger)).last_force();
+            const Vec3 f = idle(s).driven(s.finger(finger)).last_force();
             return vec3s(1, [&](std::size_t) { return f; }).attr("reshape")(3);
           },
           py::arg("finger"), "N, world: the force a driven finger's device rendered at the last tick (clamped)")

@@ -51,6 +51,10 @@ class Session {
   app::ProgramFinger& driven(std::size_t f);
   const app::RunOptions& options() const { return options_; }
 
+  // step() runs with the GIL released: while it does, every other method is refused (busy), since
+  // nothing else serialises the run. Read and written only with the GIL held.
+  bool busy = false;
+
  private:
   scripting::Scenario scenario_;
   app::RunOptions options_;

@@ -87,3 +87,24 @@ def test_a_device_that_cannot_open_writes_nothing(tmp_path):
     with pytest.raises(graspsim.DeviceError, match="could not start.*junk.h5"):
         graspsim.load(scenario, trace=out)
     assert out.read_text() == "kept" and not os.path.exists(str(out) + ".partial")
+
+
+def test_a_session_is_refused_to_other_threads_while_it_steps():
+    # step() releases the GIL; any other call on the session meanwhile would race with the run, so
+    # it raises RuntimeError "session is busy". 40 s of the lift (480000 ticks, no trace) keeps the
+    # stepping thread busy long enough for this thread to try; afterwards the session answers.
+    import threading
+
+    s = graspsim.load(LIFT, set={"duration": 40})
+    stepper = threading.Thread(target=s.step, args=(s.ticks,))
+    refused = None
+    stepper.start()
+    while stepper.is_alive() and refused is None:
+        try:
+            s.state()
+        except RuntimeError as e:
+            refused = str(e)
+    stepper.join()
+    assert refused is not None and "session is busy" in refused
+    assert s.tick == s.ticks
+    assert s.finish()["passed"] in (True, False)

@@ -87,3 +87,23 @@ def test_finish_early_reports_later_expectations_not_checked(tmp_path):
     assert not result["passed"]
     assert all(e["detail"].startswith("not checked") for e in result["expectations"])
     assert graspsim.read_trace(tmp_path / "cut.h5")["/servo/tick"][-1] == 2999
+
+
+def test_numpy_and_other_number_types_cross_as_their_value(tmp_path):
+    # np.int64 is not a Python int, and under numpy 2 repr(np.float64(0.5)) is "np.float64(0.5)":
+    # a set value is converted as a number (int() or float()), never by its repr. Floor, a float
+    # subclass whose repr is not its digits, stands for numpy 2's scalars on numpy 1. Both runs
+    # must be the plain-number run bit for bit.
+    class Floor(float):
+        def __repr__(self):
+            return "Floor(%r)" % float(self)
+
+    plain = {"mass": 0.5, "squeeze": 0.012, "gravity": [0, 0, -9.8]}
+    numpy_set = {"mass": np.float64(0.5), "squeeze": np.float64(0.012),
+                 "gravity": [np.int64(0), np.int32(0), np.float64(-9.8)]}
+    subclass_set = {"mass": Floor(0.5), "squeeze": Floor(0.012), "gravity": np.array([0, 0, -9.8])}
+    graspsim.load(LIFT, set=plain, trace=tmp_path / "plain.h5").run()
+    graspsim.load(LIFT, set=numpy_set, trace=tmp_path / "numpy.h5").run()
+    graspsim.load(LIFT, set=subclass_set, trace=tmp_path / "subclass.h5").run()
+    same_trace(tmp_path / "plain.h5", tmp_path / "numpy.h5")
+    same_trace(tmp_path / "plain.h5", tmp_path / "subclass.h5")

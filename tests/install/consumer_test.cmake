@@ -38,6 +38,31 @@ endif()
 step("configure examples/consumer against ${prefix}" ${configure})
 step("build examples/consumer" ${CMAKE_COMMAND} --build ${WORK_DIR}/consumer --config ${BUILD_TYPE})
 
+# The installed app/ headers an embedding program includes on their own compile alone with
+# graspsim::app's usage requirements (a file each that includes only it): a header that leans on
+# another's includes fails here. session.hpp is checked by the consumer (its first include);
+# run.hpp's family by the consumer too. About 1.3 s of compiling a header.
+set(alone ${WORK_DIR}/headers-alone)
+set(app_headers program_finger.hpp devices.hpp)
+set(alone_sources "")
+foreach(header ${app_headers})
+  string(REPLACE ".hpp" ".cpp" source ${header})
+  file(WRITE ${alone}/${source} "#include <graspsim/app/${header}>\n")
+  list(APPEND alone_sources ${source})
+endforeach()
+file(WRITE ${alone}/CMakeLists.txt "cmake_minimum_required(VERSION 3.20)
+project(graspsim_headers_alone LANGUAGES CXX)
+set(CMAKE_CXX_STANDARD 20)
+find_package(graspsim REQUIRED)
+add_library(headers_alone OBJECT ${alone_sources})
+target_link_libraries(headers_alone PRIVATE graspsim::app)
+")
+set(configure_alone ${configure})
+list(TRANSFORM configure_alone REPLACE "^${CONSUMER_DIR}$" "${alone}")
+list(TRANSFORM configure_alone REPLACE "^${WORK_DIR}/consumer$" "${alone}/build")
+step("configure: every installed app/ header alone" ${configure_alone})
+step("build: every installed app/ header alone" ${CMAKE_COMMAND} --build ${alone}/build --config ${BUILD_TYPE})
+
 set(scenario ${prefix}/share/graspsim/scenarios/two_finger_lift.lua)
 set(consumer ${WORK_DIR}/consumer/graspsim_consumer)
 if(NOT EXISTS ${consumer})   # a multi-config generator puts it under the configuration's name

@@ -89,10 +89,15 @@ touch "$tmp/file"
 refused "--out $tmp/file/sweep" "$lift" --grid mu=0.2 --out "$tmp/file/sweep"
 refused "holds another sweep" "$lift" --grid mu=0.2 --out "$tmp/j1"
 refused "holds this sweep already" "$lift" "${sweep_grid[@]}" --out "$tmp/j1"
+# A folder with files and no sweep.plan is not written into (its sweep.csv would be replaced).
+mkdir -p "$tmp/theirs" && printf 'their table\n' > "$tmp/theirs/sweep.csv"
+refused "--out $tmp/theirs is a folder with files and no sweep.plan" "$lift" --grid mu=0.2 --out "$tmp/theirs"
+[ "$(cat "$tmp/theirs/sweep.csv")" = "their table" ] && [ ! -e "$tmp/theirs/runs" ] \
+  || fail "a refused sweep changed $tmp/theirs"
 # The runs' --summary may not be the scenario (it would be written over).
 cp "$lift" "$tmp/lift.lua"
 "$cli" run "$tmp/lift.lua" --no-trace --summary "$tmp/lift.lua" >"$tmp/bad.log" 2>&1
-[ $? -eq 2 ] && grep -q -- "--summary $tmp/lift.lua is the scenario" "$tmp/bad.log" && cmp -s "$lift" "$tmp/lift.lua" \
+[ $? -eq 2 ] && grep -q -- "--summary '$tmp/lift.lua' is the scenario" "$tmp/bad.log" && cmp -s "$lift" "$tmp/lift.lua" \
   || { cat "$tmp/bad.log"; fail "run --summary SCENARIO was not refused, or the scenario changed"; }
 echo "ok: refused: $(head -n1 "$tmp/bad.log")"
 [ ! -e "$tmp/bad" ] || fail "a refused sweep made $tmp/bad"

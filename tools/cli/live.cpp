@@ -1,23 +1,15 @@
 // The live view's options and the server around the run (live.hpp).
 #include "cli/live.hpp"
 
-#include <spawn.h>
-
 #include <cstdio>
 #include <cstdlib>
 #include <iostream>
 
+#include "cli/view.hpp"
 #include "view/server/scene.hpp"
 #include "view/server/server.hpp"
 
-extern char** environ;
-
 namespace graspsim::cli {
-namespace {
-
-constexpr int kDefaultPort = 8717;   // as `graspsim view`'s: one page address to remember
-
-}  // namespace
 
 bool parse_live_option(const std::vector<std::string>& args, std::size_t& i, LiveOptions& live, std::string& error) {
   const std::string& a = args[i];
@@ -57,7 +49,7 @@ std::string LiveSession::start(const scripting::Scenario& scenario, const LiveOp
   channel_.emplace(model.bodies.size(), model.fingers.size());
   try {
     const std::string web = view::web_folder();
-    const int port = live.port >= 0 ? live.port : kDefaultPort;
+    const int port = live.port >= 0 ? live.port : kDefaultViewPort;
     try {
       server_ = std::make_unique<view::LiveServer>(scenario, *channel_, web, port);
     } catch (const view::ViewError&) {
@@ -74,13 +66,7 @@ std::string LiveSession::start(const scripting::Scenario& scenario, const LiveOp
   std::printf("graspsim: live view  %s  (the run does not wait for it%s)\n", server_->url().c_str(),
               asked ? "" : "; --no-view leaves it out");
   std::fflush(stdout);
-  if (live.open) {
-    pid_t pid = 0;
-    const std::string url = server_->url();
-    const char* argv[] = {"xdg-open", url.c_str(), nullptr};
-    if (posix_spawnp(&pid, "xdg-open", nullptr, nullptr, const_cast<char* const*>(argv), environ) != 0)
-      std::cerr << "graspsim: --open: xdg-open could not be started; open " << url << " yourself\n";
-  }
+  if (live.open) open_browser(server_->url(), "graspsim");
   return "";
 }
 

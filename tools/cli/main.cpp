@@ -17,6 +17,7 @@
 #include "app/pacer.hpp"
 #include "app/run.hpp"
 #include "app/run_budget.hpp"
+#include "app/run_trace.hpp"
 #include "app/sweep_row.hpp"
 #include "cli/repair.hpp"
 #include "cli/replay.hpp"
@@ -422,23 +423,24 @@ int run_command(const std::vector<std::string>& args) {
     std::cerr << "graspsim: warning: " << w << "\n";
   };
 
-  // The summary may be none of the run's inputs, nor its trace (checked before anything runs).
+  // The summary may be none of the run's inputs, nor its trace; its partial is never a file
+  // already there (checked before anything runs).
   if (!summary.empty()) {
-    std::vector<graspsim::app::InputFile> inputs = options.inputs;
-    inputs.push_back({scenario->path(), "the scenario"});
-    for (const std::string& f : scenario->files()) inputs.push_back({f, "a mesh file of the scenario"});
+    std::vector<graspsim::app::InputFile> inputs = graspsim::app::run_inputs(*scenario, options);
     if (!no_trace) {
       const std::string trace = out.empty() ? graspsim::app::default_trace_name(scenario->name()) : out;
       inputs.push_back({trace, "the trace"});
       inputs.push_back({graspsim::app::partial_name(trace), "the trace"});
     }
-    for (const auto& input : inputs) {
-      std::error_code ec;
-      for (const std::string& written : {summary, summary + ".partial"})
-        if (written == input.path || std::filesystem::equivalent(written, input.path, ec))
-          return bad_input("--summary " + summary + " is " + input.what + " ('" + input.path +
-                           "'): it would be written over; choose another file");
+    try {
+      graspsim::app::refuse_input_as_output(summary, inputs, "--summary");
+    } catch (const graspsim::app::OutputError& e) {
+      return bad_input(e.what());
     }
+    std::error_code ec;
+    if (std::filesystem::symlink_status(summary + ".partial", ec).type() != std::filesystem::file_type::not_found)
+      return bad_input("--summary " + summary + " is written as " + summary + ".partial, and a file of that name is "
+                       "there: move it away (it is not written over)");
   }
 
   // A run that will not fit (memory for its trace buffers, disk for its trace) is refused
@@ -499,18 +501,17 @@ int run_command(const std::vector<std::string>& args) {
                  no_trace ? "" : "  (the trace keeps every tick up to there)\n");
   }
   const int failed = graspsim::cli::print_expectations(result, quiet);
-  if (!summary.empty()) {   // written whole (a .partial renamed), so a reader never sees half
-    const std::string partial = summary + ".partial";
-    const std::string text = graspsim::app::sweep::summary_text(result.expectations);
-    std::FILE* f = std::fopen(partial.c_str(), "w");
-    bool written = f && std::fwrite(text.data(), 1, text.size(), f) == text.size();
-    if (f) written = std::fclose(f) == 0 && written;
-    if (!written || std::rename(partial.c_str(), summary.c_str()) != 0) {
-      std::remove(partial.c_str());
-      std::fprintf(stderr, "graspsim: cannot write --summary %s\n", summary.c_str());
+  // A summary that cannot be written is an output fault, as a trace that cannot: exit 3, so that
+  // a sweep records the run as an error instead of a pass with no expectation read.
+  bool summary_fault = false;
+  if (!summary.empty()) {
+    const std::string e = graspsim::app::sweep::write_summary(summary, graspsim::app::sweep::summary_text(result.expectations));
+    if (!e.empty()) {
+      std::fprintf(stderr, "graspsim: --summary: %s\n", e.c_str());
+      summary_fault = true;
     }
   }
-  if (!result.trace_error.empty()) return kExitTraceFault;
+  if (!result.trace_error.empty() || summary_fault) return kExitTraceFault;
   if (result.interrupted) return graspsim::cli::exit_interrupted(&g_signal);
   if (!result.error.empty()) return kExitBadInput;
   if (!quiet) {

@@ -11,8 +11,9 @@ namespace graspsim::cli {
 constexpr int kExitOk = 0;            // every expectation held
 constexpr int kExitFailed = 1;        // an expectation failed
 constexpr int kExitBadInput = 2;      // bad input: arguments, scenario, output path, script error
-constexpr int kExitTraceFault = 3;    // the trace could not be written to its end (a full disk):
-                                      // it keeps every tick up to its last flush, marked
+constexpr int kExitTraceFault = 3;    // an output the run owes could not be written: the --summary,
+                                      // or the trace to its end (a full disk): the trace
+                                      // keeps every tick up to its last flush, marked
 constexpr int kExitInterrupted = 130; // Ctrl-C (128 + SIGINT); SIGTERM 143, SIGHUP 129
 
 // 128 + the signal that stopped the run (SIGINT if none is known).

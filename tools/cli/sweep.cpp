@@ -49,8 +49,9 @@ constexpr const char* kSweepHelp =
     "  --seeds N            N jitter seeds per grid point (1 .. 1000000)\n"
     "  --jitter A           the seeds' jitter amplitude in m (default 0.5e-3)\n"
     "  --jobs N             runs at once (default: the number of processors)\n"
-    "  --out DIR            the sweep's folder (made if missing; one holding another sweep is\n"
-    "                       refused, and one holding this sweep needs --resume)\n"
+    "  --out DIR            the sweep's folder (made if missing; one holding another sweep, or\n"
+    "                       files and no sweep.plan, is refused; one holding this sweep needs\n"
+    "                       --resume)\n"
     "  --keep-traces        each run writes DIR/runs/<run>.h5 (default: --no-trace)\n"
     "  --resume             keep the rows of finished runs in DIR and run only the others\n"
     "  --slurm              submit the runs as a Slurm job array (sbatch --array; sbatch's own\n"
@@ -211,10 +212,20 @@ int sweep_command(const std::vector<std::string>& args) {
   plan.scenario = fs::absolute(plan.scenario).lexically_normal().string();
   if (const std::string why = check_overrides(plan); !why.empty()) return bad_input(why);
 
-  // The folder: made if missing; its plan file says which sweep it holds.
+  // The folder: made if missing; its plan file says which sweep it holds. A folder that holds
+  // files but no plan is someone else's: its sweep.csv, .h5 and .png would be written over.
   const std::string dir = fs::absolute(out).lexically_normal().string();
   const std::string plan_file = (fs::path(dir) / "sweep.plan").string();
   std::error_code ec;
+  if (fs::is_directory(dir, ec) && !fs::exists(plan_file, ec)) {
+    for (const auto& entry : fs::directory_iterator(dir, ec)) {
+      const bool empty_runs = entry.path().filename() == "runs" && fs::is_directory(entry.path(), ec) &&
+                              fs::is_empty(entry.path(), ec);   // a sweep that stopped before its plan
+      if (!empty_runs)
+        return bad_input("--out " + out + " is a folder with files and no sweep.plan, not a sweep's: its files "
+                         "would be written over; choose a new or empty folder");
+    }
+  }
   fs::create_directories(fs::path(dir) / "runs", ec);
   if (ec) return bad_input("--out " + out + ": cannot make the folder: " + ec.message());
   if (fs::exists(plan_file)) {
@@ -223,11 +234,13 @@ int sweep_command(const std::vector<std::string>& args) {
       return bad_input("--out " + out + " holds another sweep (" + plan_file + " differs): choose another folder");
     if (!resume) return bad_input("--out " + out + " holds this sweep already: --resume to go on with it");
   } else {
-    std::ofstream file(plan_file);
+    // Written whole or not at all (a .partial renamed): a cut plan would hold another sweep.
+    const std::string partial = plan_file + ".partial";
+    std::ofstream file(partial, std::ios::trunc);
     file << plan.text();
     file.close();
-    if (!file) {
-      std::remove(plan_file.c_str());
+    if (!file || std::rename(partial.c_str(), plan_file.c_str()) != 0) {
+      std::remove(partial.c_str());
       return bad_input("--out " + out + ": cannot write " + plan_file);
     }
   }

@@ -16,12 +16,6 @@ namespace graspsim::cli {
 namespace fs = std::filesystem;
 using namespace app::sweep;
 
-std::string shell_quote(const std::string& s) {
-  std::string out = "'";
-  for (const char c : s) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return out + "'";
-}
-
 std::string run_slurm(const std::string& program, const Plan& plan, const std::string& dir,
                       const std::vector<std::size_t>& pending,
                       const std::function<void(std::size_t, std::size_t)>& progress, const std::atomic<bool>& stop) {
@@ -32,16 +26,10 @@ std::string run_slurm(const std::string& program, const Plan& plan, const std::s
   const std::string script = (slurm / "job.sh").string();
   {
     std::ofstream out(script, std::ios::trunc);
-    out << "#!/bin/sh\n"
-        << "# One run of the graspsim sweep in " << dir << " per array task (graspsim sweep --slurm).\n"
-        << "#SBATCH --job-name=graspsim-sweep\n"
-        << "#SBATCH --ntasks=1\n"
-        << "#SBATCH --cpus-per-task=1\n"
-        << "#SBATCH --output=" << (slurm / "task-%a.out").string() << "\n"
-        << "exec " << shell_quote(program) << " sweep-task " << shell_quote(dir) << " \"$SLURM_ARRAY_TASK_ID\"\n";
+    out << slurm_job_script(program, dir);
     if (!out) return "cannot write " + script;
   }
-  const std::string submit = "sbatch --parsable --array=" + array_list(pending) + " " + shell_quote(script);
+  const std::string submit = sbatch_command(script, slurm.string(), array_list(pending));
   FILE* p = popen((submit + " 2>&1").c_str(), "r");
   if (!p) return "cannot run sbatch";
   std::string reply;
@@ -54,19 +42,39 @@ std::string run_slurm(const std::string& program, const Plan& plan, const std::s
   std::fprintf(stderr, "graspsim sweep: submitted %zu runs as Slurm job array %s (%s)\n", pending.size(), job.c_str(),
                script.c_str());
   std::size_t reported = 0;
+  // s: how long squeue may fail in a row (each failure can itself take seconds: it retries the
+  // controller) before the sweep gives up waiting.
+  constexpr double kSqueueFailing = 60.0;
+  int failures = 0;                                  // squeue failures in a row
+  std::chrono::steady_clock::time_point failing_since;
   for (;;) {
     if (stop.load()) {
       std::system(("scancel " + job).c_str());
       return "stopped: cancelled job " + job;
     }
-    FILE* q = popen(("squeue -h -j " + job + " -o %i 2>/dev/null").c_str(), "r");
+    // Empty output means the array has left the queue only when squeue answered (exit 0); a job
+    // id the controller has already forgotten is ended too. Any other failure (the controller
+    // down or restarting) is retried for up to kSqueueFailing seconds in a row.
+    FILE* q = popen(("squeue -h -j " + job + " -o %i 2>&1").c_str(), "r");
     std::string queued;
     while (q && std::fgets(buf, sizeof buf, q)) queued += buf;
-    if (q) pclose(q);
+    const int squeue_status = q ? pclose(q) : -1;
     std::size_t done = 0;
     for (const std::size_t i : pending) done += read_row(plan, dir, i).has_value();
     if (done != reported) progress(reported = done, pending.size());
-    if (queued.find_first_not_of(" \n") == std::string::npos) return {};
+    if (squeue_status == 0) {
+      failures = 0;
+      if (queued.find_first_not_of(" \n") == std::string::npos) return {};
+    } else if (queued.find("Invalid job id") != std::string::npos) {
+      return {};
+    } else if (++failures == 1) {
+      failing_since = std::chrono::steady_clock::now();
+    } else if (std::chrono::duration<double>(std::chrono::steady_clock::now() - failing_since).count() > kSqueueFailing) {
+      return "squeue failed " + std::to_string(failures) + " times in a row (" +
+             std::to_string(static_cast<int>(kSqueueFailing)) + " s) while job " + job +
+             " may still run (its runs' rows are kept; rerun with --resume once Slurm answers): " +
+             (queued.empty() ? "no output" : queued.substr(0, queued.find_last_not_of(" \n") + 1));
+    }
     std::this_thread::sleep_for(std::chrono::milliseconds(500));
   }
 }

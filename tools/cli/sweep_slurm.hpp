@@ -7,11 +7,11 @@
 #include <vector>
 
 #include "app/sweep_plan.hpp"
+#include "app/sweep_slurm.hpp"
 
 namespace graspsim::cli {
 
-// `s` in single quotes for /bin/sh.
-std::string shell_quote(const std::string& s);
+using app::sweep::shell_quote;
 
 // Writes DIR/slurm/job.sh (one array task: `program sweep-task DIR $SLURM_ARRAY_TASK_ID`),
 // submits `pending` with `sbatch --array`, and waits until none of its tasks is pending or

@@ -4,7 +4,9 @@
 #include <pthread.h>
 #include <signal.h>
 #include <spawn.h>
+#include <sys/wait.h>
 
+#include <cerrno>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -21,8 +23,6 @@ extern char** environ;
 
 namespace graspsim::cli {
 namespace {
-
-constexpr int kDefaultPort = 8717;
 
 constexpr const char* kViewHelp =
     "usage: graspsim view TRACE.h5 [B.h5] [--port N] [--open]\n"
@@ -56,13 +56,6 @@ int bad(const std::string& message) {
   return kExitBadInput;
 }
 
-void open_browser(const std::string& url) {
-  pid_t pid = 0;
-  const char* argv[] = {"xdg-open", url.c_str(), nullptr};
-  if (posix_spawnp(&pid, "xdg-open", nullptr, nullptr, const_cast<char* const*>(argv), environ) != 0)
-    std::cerr << "graspsim view: --open: xdg-open could not be started; open " << url << " yourself\n";
-}
-
 // B of `graspsim view A B`: its scene packed, and where it first differs from A (/compare.json).
 std::pair<view::Packed, std::string> load_ghost(const std::string& a, const std::string& b) {
   const view::ViewScene scene = view::load_scene(b);
@@ -80,7 +73,7 @@ std::pair<view::Packed, std::string> load_ghost(const std::string& a, const std:
 
 int view_command(const std::vector<std::string>& args) {
   std::string trace, ghost;
-  int port = kDefaultPort;
+  int port = kDefaultViewPort;
   bool open = false;
   for (std::size_t i = 0; i < args.size(); ++i) {
     const std::string& a = args[i];
@@ -140,7 +133,7 @@ int view_command(const std::vector<std::string>& args) {
   }
   std::printf("  url  %s  (Ctrl-C to stop)\n", server->url().c_str());
   std::fflush(stdout);
-  if (open) open_browser(server->url());
+  if (open) open_browser(server->url(), "graspsim view");
 
   std::thread waiter([&] {
     int signal = 0;
@@ -152,6 +145,29 @@ int view_command(const std::vector<std::string>& args) {
   waiter.join();
   if (!served) return bad("serving " + server->url() + " failed");
   return kExitOk;
+}
+
+void open_browser(const std::string& url, const std::string& who) {
+  // sh starts xdg-open in the background and exits: waiting for sh is immediate, and xdg-open,
+  // orphaned, is reaped by init. 127: no xdg-open on PATH.
+  const char* argv[] = {"sh", "-c", "command -v xdg-open >/dev/null 2>&1 || exit 127; xdg-open \"$1\" &", "sh",
+                        url.c_str(), nullptr};
+  // With no signal blocked: the caller may block the stop signals, and a mask is inherited.
+  posix_spawnattr_t attr;
+  posix_spawnattr_init(&attr);
+  sigset_t none;
+  sigemptyset(&none);
+  posix_spawnattr_setsigmask(&attr, &none);
+  posix_spawnattr_setflags(&attr, POSIX_SPAWN_SETSIGMASK);
+  pid_t pid = 0;
+  int status = 0;
+  const bool started = posix_spawnp(&pid, "sh", nullptr, &attr, const_cast<char* const*>(argv), environ) == 0;
+  posix_spawnattr_destroy(&attr);
+  if (started)
+    while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+    }
+  if (!started || !WIFEXITED(status) || WEXITSTATUS(status) != 0)
+    std::cerr << who << ": --open: xdg-open could not be started; open " << url << " yourself\n";
 }
 
 }  // namespace graspsim::cli

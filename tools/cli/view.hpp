@@ -11,4 +11,12 @@ namespace graspsim::cli {
 // missing), before anything is served.
 int view_command(const std::vector<std::string>& args);
 
+// The port both views serve on unless --port says otherwise: one page address to remember.
+constexpr int kDefaultViewPort = 8717;
+
+// Starts xdg-open on `url` for --open, not waiting for the browser. The starter is reaped at once
+// (xdg-open is left to init), so no zombie stays for the session. When xdg-open is not there,
+// says so on stderr, prefixed by `who` ("graspsim view").
+void open_browser(const std::string& url, const std::string& who);
+
 }  // namespace graspsim::cli

@@ -6,12 +6,14 @@
 
 #include <httplib.h>
 
+#include <atomic>
 #include <chrono>
 #include <condition_variable>
 #include <cstdio>
 #include <mutex>
 #include <thread>
 
+#include "view/server/http.hpp"
 #include "view/server/pack.hpp"
 #include "view/server/scene.hpp"
 
@@ -91,6 +93,7 @@ struct LiveServer::Impl {
   std::string scene_json;
   int port = 0;
   std::thread server, pump;
+  std::atomic<bool> listen_returned{false};   // the server thread's listen has returned
 
   std::mutex mutex;                 // guards what follows, between the pump and the streams
   std::condition_variable changed;
@@ -187,26 +190,16 @@ LiveServer::LiveServer(const scripting::Scenario& scenario, app::LiveChannel& ch
           im.changed.notify_all();
         });
   });
-  http.Get("/favicon.ico", [](const httplib::Request&, httplib::Response& res) { res.status = 204; });
-  http.set_keep_alive_timeout(1);
-  // As ViewServer (server.cpp): .js as a type httplib does not brotli-compress, and
-  // SO_REUSEADDR without SO_REUSEPORT, so a port another server listens on is refused.
-  http.set_file_extension_and_mimetype_mapping("js", "application/x-javascript");
-  http.set_mount_point("/", web);
-  http.set_socket_options([](socket_t sock) {
-    int yes = 1;
-    setsockopt(sock, SOL_SOCKET, SO_REUSEADDR, &yes, sizeof yes);
-  });
-  if (port == 0) {
-    im.port = http.bind_to_any_port("127.0.0.1");
-    if (im.port <= 0) throw ViewError("cannot listen on 127.0.0.1: no free port");
-  } else {
-    if (!http.bind_to_port("127.0.0.1", port))
-      throw ViewError("cannot listen on 127.0.0.1:" + std::to_string(port) +
-                      " (the port is in use, or needs privileges): choose another with --port N, or --port 0 for any free one");
-    im.port = port;
+  im.port = configure_and_bind(http, web, port);
+  im.server = std::thread([&im] { listen_marking(im.http, im.listen_returned); });
+  // s: how long the listening thread may take to start before the view is given up.
+  constexpr double kStartLimit = 2.0;
+  if (!wait_running(http, im.listen_returned, kStartLimit)) {
+    stop_until_returned(http, im.listen_returned);
+    im.server.join();
+    throw ViewError("cannot serve on 127.0.0.1:" + std::to_string(im.port) + ": the server did not start within " +
+                    std::to_string(static_cast<int>(kStartLimit)) + " s");
   }
-  im.server = std::thread([&im] { im.http.listen_after_bind(); });
   im.pump = std::thread([&im] { im.run_pump(); });
 }
 
@@ -217,9 +210,6 @@ void LiveServer::end(const LiveEnd& end, double wait_s) {
   {
     std::lock_guard<std::mutex> lock(im.mutex);
     if (!im.end_message.empty() || im.stopping) return;
-  }
-  {
-    std::lock_guard<std::mutex> lock(im.mutex);
     im.pump_done = true;
   }
   if (im.pump.joinable()) im.pump.join();
@@ -238,7 +228,7 @@ LiveServer::~LiveServer() {
     im.changed.notify_all();
   }
   if (im.pump.joinable()) im.pump.join();
-  im.http.stop();
+  stop_until_returned(im.http, im.listen_returned);
   if (im.server.joinable()) im.server.join();
 }
 

@@ -1,7 +1,7 @@
 // cpp-httplib serving the page, /scene.json and /trace.bin.
 #include "view/server/server.hpp"
 
-#include <httplib.h>
+#include "view/server/http.hpp"
 
 #include <cstdlib>
 #include <filesystem>
@@ -25,6 +25,7 @@ struct ViewServer::Impl {
   Packed packed;
   Packed overlay;            // the second run of `graspsim view A B`
   std::string compare;       // /compare.json
+  std::atomic<bool> listen_returned{false};   // serve() has returned
 };
 
 ViewServer::ViewServer(Packed packed, std::string web, int port) : impl_(std::make_unique<Impl>()) {
@@ -39,34 +40,7 @@ ViewServer::ViewServer(Packed packed, std::string web, int port) : impl_(std::ma
     res.set_header("Cache-Control", "no-store");
     res.set_content(p.blob, "application/octet-stream");
   });
-  // A page left open holds its keep-alive connections on the pool's threads, and stop() waits for
-  // them: 1 s of idle keeps Ctrl-C prompt (httplib's default is 5 s).
-  http.set_keep_alive_timeout(1);
-  http.Get("/favicon.ico", [](const httplib::Request&, httplib::Response& res) { res.status = 204; });
-  // Debian's httplib compresses text/*, application/javascript and application/json replies
-  // with brotli at its highest quality when the browser accepts it: 3.3 s for three.core.js
-  // (1.5 MB) on this machine, for a page served over loopback. application/x-javascript, a
-  // JavaScript MIME type browsers accept for modules (HTML standard, "JavaScript MIME type"),
-  // is one it leaves alone.
-  http.set_file_extension_and_mimetype_mapping("js", "application/x-javascript");
-  http.set_mount_point("/", web);
-  // httplib's default socket sets SO_REUSEPORT, which lets a second listener bind a port one
-  // already holds (another graspsim view) and the kernel then shares the connections between
-  // them: a page could load one trace's scene and another's columns. SO_REUSEADDR alone still
-  // rebinds a port a closed server left in TIME_WAIT, and refuses one that is listened on.
-  http.set_socket_options([](socket_t sock) {
-    int yes = 1;
-    setsockopt(sock, SOL_SOCKET, SO_REUSEADDR, &yes, sizeof yes);
-  });
-  if (port == 0) {
-    port_ = http.bind_to_any_port("127.0.0.1");
-    if (port_ <= 0) throw ViewError("cannot listen on 127.0.0.1: no free port");
-  } else {
-    if (!http.bind_to_port("127.0.0.1", port))
-      throw ViewError("cannot listen on 127.0.0.1:" + std::to_string(port) +
-                      " (the port is in use, or needs privileges): choose another with --port N, or --port 0 for any free one");
-    port_ = port;
-  }
+  port_ = configure_and_bind(http, web, port);
 }
 
 void ViewServer::add_overlay(Packed b, std::string compare_json) {
@@ -86,8 +60,8 @@ void ViewServer::add_overlay(Packed b, std::string compare_json) {
 
 ViewServer::~ViewServer() = default;
 
-bool ViewServer::serve() { return impl_->http.listen_after_bind(); }
+bool ViewServer::serve() { return listen_marking(impl_->http, impl_->listen_returned); }
 
-void ViewServer::stop() { impl_->http.stop(); }
+void ViewServer::stop() { stop_until_returned(impl_->http, impl_->listen_returned); }
 
 }  // namespace graspsim::view

@@ -31,6 +31,8 @@ class ViewServer {
   std::string url() const { return "http://127.0.0.1:" + std::to_string(port_) + "/"; }
   // Serves until stop() (from another thread). Returns false if listening failed.
   bool serve();
+  // Returns once serve() has returned; a stop that comes before serve() has started listening is
+  // not lost. Only while serve() runs or is sure to be called.
   void stop();
 
  private:
