@@ -80,9 +80,9 @@ bool RunSession::step() {
     run_->watch(n);
     run_->count();
     run_->feed_script(n);
+    run_->publish_live(n);   // before a stop can end the run: the view's last tick is the trace's
     run_->check_interrupt(n);
     run_->report_progress(n);
-    run_->publish_live(n);
   } catch (...) {
     run_->fail(failure(result_.servo_ticks));
     stopped_ = true;

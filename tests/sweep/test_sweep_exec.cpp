@@ -14,7 +14,7 @@
 namespace fs = std::filesystem;
 using namespace graspsim::app;
 
-TEST_CASE("a run's partial trace left by a killed run is removed before the rerun; one a live run holds is kept",
+TEST_CASE("a run's partial trace left by a killed run is removed before the rerun, and one a live run holds is kept",
           "[sweep]") {
   // A SIGKILLed run leaves runs/<index>.h5.partial holding bytes; the rerun's OutputClaim refuses a
   // non-empty unlocked partial, so without the removal `--resume --keep-traces` made the row a
