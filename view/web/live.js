@@ -29,6 +29,9 @@ export function startLive(scene) {
   const source = new EventSource('live');
   source.onmessage = (e) => { latest = JSON.parse(e.data); messages++; };
   source.addEventListener('end', (e) => {
+    // The run's last snapshot came just before; drawn now, not at the next frame, so that what
+    // the page shows once it says the run ended is that last tick.
+    if (latest && latest !== drawn) draw(latest);
     ended = JSON.parse(e.data);
     source.close();
     const trace = ended.trace ? ` Its trace: ${ended.trace} (\`graspsim view ${ended.trace}\` shows it with the timeline).` : ' No trace was written.';
