@@ -41,19 +41,7 @@ ViewScene live_scene(const scripting::Scenario& scenario) {
   s.rate_haptic = m.rates.haptic;
   s.rate_physics = m.rates.physics;
   s.duration = scenario.duration();
-  s.floor = m.floor.enabled;
-  s.floor_height = m.floor.height;
-  for (const BodyParams& b : m.bodies) {   // the shapes only: the poses come over /live
-    BodyView& v = s.bodies.emplace_back();
-    v.name = b.name;
-    v.shape_known = true;
-    v.shape = b.shape;
-  }
-  for (const FingerParams& f : m.fingers) {
-    FingerView& v = s.fingers.emplace_back();
-    v.name = f.name;
-    v.radius = f.radius;
-  }
+  add_model(m, s);   // the shapes only: the poses come over /live
   return s;
 }
 

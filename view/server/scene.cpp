@@ -213,6 +213,22 @@ void load_contacts(ViewScene& s) {
 
 }  // namespace
 
+void add_model(const Model& m, ViewScene& s) {
+  s.floor = m.floor.enabled;
+  s.floor_height = m.floor.height;
+  for (const BodyParams& b : m.bodies) {
+    BodyView& v = s.bodies.emplace_back();
+    v.name = b.name;
+    v.shape_known = true;
+    v.shape = b.shape;
+  }
+  for (const FingerParams& f : m.fingers) {
+    FingerView& v = s.fingers.emplace_back();
+    v.name = f.name;
+    v.radius = f.radius;
+  }
+}
+
 ViewScene load_scene(const std::string& trace) {
   require_trace(trace);
   ViewScene s;
@@ -229,20 +245,7 @@ ViewScene load_scene(const std::string& trace) {
     std::string why;
     const std::optional<scripting::Scenario> scenario = recorded_scenario(trace, why);
     if (scenario) {
-      const Model& m = scenario->model();
-      s.floor = m.floor.enabled;
-      s.floor_height = m.floor.height;
-      for (const BodyParams& b : m.bodies) {
-        BodyView& v = s.bodies.emplace_back();
-        v.name = b.name;
-        v.shape_known = true;
-        v.shape = b.shape;
-      }
-      for (const FingerParams& f : m.fingers) {
-        FingerView& v = s.fingers.emplace_back();
-        v.name = f.name;
-        v.radius = f.radius;
-      }
+      add_model(scenario->model(), s);
     } else {
       // Names from the columns, shapes unknown: the page draws placeholders and says why.
       s.floor = true;

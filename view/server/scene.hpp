@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "graspsim/engine/model.hpp"
 #include "graspsim/engine/shape.hpp"
 
 namespace graspsim::view {
@@ -73,5 +74,9 @@ struct ViewScene {
 // Reads `trace`. Tables are cut to the ticks all of them hold (a cut trace's tables may differ by
 // a flush interval), so the page shows the run up to its last common tick. Throws ViewError.
 ViewScene load_scene(const std::string& trace);
+
+// The floor, and each body's shape and each finger's pad radius, from a scenario's model (no rows):
+// what a trace's recorded scenario and a live run both give the page.
+void add_model(const Model& model, ViewScene& scene);
 
 }  // namespace graspsim::view
