@@ -25,9 +25,11 @@ enum class Layout {
   kTower,     // one column, each box on the one below, touching (+ gap)
   kPyramid,   // a 2-D pyramid (rows of n_row, n_row - 1, ..., 1 boxes), each box on two below;
               // n is rounded down to a triangular number r (r + 1) / 2
-  kPile,      // boxes dropped in columns 12 cm apart on a 12 cm grid, at most 10 a column
-              // (the top ~1.2 m up), each offset by up to 2 cm and turned by up to 0.3 rad
-              // (a fixed generator), so that they topple into a pile
+  kPile,      // boxes dropped in columns on an 18 cm grid, 12 cm apart up a column, at most 10
+              // a column (the top ~1.2 m up), each offset by up to 2 cm and turned by up to
+              // 0.3 rad (a fixed generator), so that they land askew and topple into a pile.
+              // None overlaps at the start: a 10 cm box turned 0.3 rad spans 0.05 (cos + sin)
+              // = 6.4 cm from its centre, 8.4 cm with its offset, under half of 18 cm
 };
 
 inline const char* layout_name(Layout l) {
@@ -102,7 +104,7 @@ inline std::vector<BoxPose> layout_boxes(Layout layout, int n, double gap = 0.0,
       const int side = static_cast<int>(std::ceil(std::sqrt(std::ceil(n / 10.0))));   // columns a side
       for (int i = 0; i < n; ++i) {
         const int column = i % (side * side), level = i / (side * side);
-        const double cx = (column % side - 0.5 * (side - 1)) * 0.12, cy = (column / side - 0.5 * (side - 1)) * 0.12;
+        const double cx = (column % side - 0.5 * (side - 1)) * 0.18, cy = (column / side - 0.5 * (side - 1)) * 0.18;
         const double dx = 0.02 * uniform(), dy = 0.02 * uniform(), yaw = 0.3 * uniform();
         boxes.push_back({cx + dx, cy + dy, half + 0.01 + 0.12 * level, yaw});
       }
