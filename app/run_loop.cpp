@@ -90,6 +90,8 @@ void Run::prepare() {
                                 " bodies and " + std::to_string(options_.live->fingers()) + " fingers; the scenario has " +
                                 std::to_string(model_.bodies.size()) + " and " + std::to_string(model_.fingers.size()));
   Simulation& sim = sim_.emplace(model_);
+  stability_.use_contacts(sim.contacts());   // one contact gather, one FCL world, for the run
+  energy_.use_contacts(sim.contacts());
   sim.record_contacts(options_.trace.write && options_.trace.record.records(recordings::RecordedLoop::kContacts));
   trace_.open_tables(model_, options_.trace.block_rows, start_);
   const std::int64_t device_every = options_.trace.record.of(recordings::RecordedLoop::kDevices);

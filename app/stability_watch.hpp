@@ -25,6 +25,9 @@ class StabilityWatch {
   // `on_warning` (may be empty) receives each warning line as it is given.
   StabilityWatch(const Model& model, bool refuse, std::function<void(const std::string&)> on_warning);
 
+  // The points of touching pairs from the run's own gather (Simulation::contacts()) from now on.
+  void use_contacts(ContactGather& contacts) { monitor_.use_contacts(contacts); }
+
   // The model's estimates (stability_warnings), before the run: warnings, never a refusal.
   void before_run();
 

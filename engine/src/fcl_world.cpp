@@ -8,10 +8,33 @@
 
 namespace graspsim::detail {
 
+namespace {
+
+// FCL keeps an object's box protected; a grown box is set through a derived type, the object
+// created as one (FclWorld's constructor), so the cast is to its own type.
+struct GrowableObject : fcl::CollisionObjectd {
+  using fcl::CollisionObjectd::CollisionObjectd;
+  void grow(double m) {
+    aabb.min_ -= Vec3::Constant(m);
+    aabb.max_ += Vec3::Constant(m);
+  }
+};
+
+void place(fcl::CollisionObjectd& object, const Mat3& rotation, const Vec3& position, double margin = 0.0) {
+  fcl::Transform3d tf = fcl::Transform3d::Identity();
+  tf.linear() = rotation;
+  tf.translation() = position;
+  object.setTransform(tf);
+  object.computeAABB();
+  if (margin > 0.0) static_cast<GrowableObject&>(object).grow(margin);
+}
+
+}  // namespace
+
 FclWorld::FclWorld(const Model& model) {
   std::vector<fcl::CollisionObjectd*> objects;
   for (std::size_t i = 0; i < model.bodies.size(); ++i) {
-    bodies.push_back(std::make_unique<fcl::CollisionObjectd>(fcl_geometry(model.bodies[i].shape)));
+    bodies.push_back(std::make_unique<GrowableObject>(fcl_geometry(model.bodies[i].shape)));
     bodies.back()->setUserData(reinterpret_cast<void*>(static_cast<std::intptr_t>(i + 1)));
     objects.push_back(bodies.back().get());
   }
@@ -19,20 +42,10 @@ FclWorld::FclWorld(const Model& model) {
   broadphase.setup();
 }
 
-namespace {
 
-void place(fcl::CollisionObjectd& object, const Mat3& rotation, const Vec3& position) {
-  fcl::Transform3d tf = fcl::Transform3d::Identity();
-  tf.linear() = rotation;
-  tf.translation() = position;
-  object.setTransform(tf);
-  object.computeAABB();
-}
-
-}  // namespace
-
-void FclWorld::update(const State& state) {
-  for (std::size_t i = 0; i < bodies.size(); ++i) place(*bodies[i], state.bodies[i].rotation, state.bodies[i].position);
+void FclWorld::update(const State& state, const std::vector<double>* margin) {
+  for (std::size_t i = 0; i < bodies.size(); ++i)
+    place(*bodies[i], state.bodies[i].rotation, state.bodies[i].position, margin ? (*margin)[i] : 0.0);
   broadphase.update();
 }
 

@@ -19,7 +19,9 @@ struct FclWorld {
 
   // Moves the objects to the bodies' poses in `state` and refits the tree. Queries sort what
   // they find, so results never depend on the tree's shape, which follows its update history.
-  void update(const State& state);
+  // With `margin` (m, per body), each box is grown by it on every side: two bodies whose boxes
+  // then overlap are within the sum of their margins (the implicit step's reach, contact_gather.hpp).
+  void update(const State& state, const std::vector<double>* margin = nullptr);
   // The same with the poses the fast loops see at state.tick (local_model.hpp).
   void update_fast_loops(const Model& model, const State& state);
 

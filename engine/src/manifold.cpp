@@ -110,7 +110,7 @@ void ManifoldScratch::reserve_for(const HullEdges& a, const HullEdges& b) {
 }
 
 int manifold(const HullEdges& ha, const Vec3& xa, const Mat3& ra, const HullEdges& hb, const Vec3& xb,
-             const Mat3& rb, ManifoldScratch& s, ManifoldPoint* out, int capacity) {
+             const Mat3& rb, ManifoldScratch& s, ManifoldPoint* out, int capacity, double margin) {
   const ConvexPolyhedron& a = *ha.hull;
   const ConvexPolyhedron& b = *hb.hull;
   s.world_a.clear();
@@ -120,9 +120,9 @@ int manifold(const HullEdges& ha, const Vec3& xa, const Mat3& ra, const HullEdge
 
   // 1. Separating axes: faces of A, faces of B, then edge pairs.
   const FaceQuery fa = query_faces(a, xa, ra, s.world_b);
-  if (fa.separation > 0.0) return 0;
+  if (fa.separation > margin) return 0;
   const FaceQuery fb = query_faces(b, xb, rb, s.world_a);
-  if (fb.separation > 0.0) return 0;
+  if (fb.separation > margin) return 0;
   double edge_sep = -std::numeric_limits<double>::infinity();
   int edge_a = -1, edge_b = -1;
   Vec3 edge_axis = Vec3::Zero();
@@ -150,7 +150,7 @@ int manifold(const HullEdges& ha, const Vec3& xa, const Mat3& ra, const HullEdge
         sep = min_a - max_b;
         axis = -axis;
       }
-      if (sep > 0.0) return 0;
+      if (sep > margin) return 0;
       if (sep > edge_sep) {
         edge_sep = sep;
         edge_a = i;
@@ -160,11 +160,24 @@ int manifold(const HullEdges& ha, const Vec3& xa, const Mat3& ra, const HullEdge
     }
   }
 
-  // 2. An edge-edge contact when its axis is clearly the least penetrating one.
-  const double face_sep = std::max(fa.separation, fb.separation);
+  // 2. The reference face: A's unless B's is clearly less penetrating (Box2D's relative tolerance,
+  // so that the choice seldom flickers on a resting stack; applied to how far the two separations
+  // are apart, which works on either side of zero).
   constexpr double kRelative = 0.98;   // Box2D's k_relativeTol: hysteresis between choices
   constexpr double kAbsolute = 1e-6;   // m
-  if (edge_a >= 0 && edge_sep > kRelative * face_sep + kAbsolute) {
+  const auto clearly_beyond = [](double x) {   // m: what a separation must beat to be clearly less deep than x
+    return (x <= 0.0 ? kRelative * x : (2.0 - kRelative) * x) + kAbsolute;
+  };
+  const bool flip = fb.separation > clearly_beyond(fa.separation);
+  const Vec3 n_ref = flip ? Vec3(rb * b.faces[fb.face].normal) : Vec3(ra * a.faces[fa.face].normal);
+
+  // 3. An edge-edge contact when its axis is clearly the least penetrating one and not nearly the
+  // reference face's normal: two faces nearly parallel (a box landing tilted on another, its edge
+  // crossing the other's edge) touch over their overlap, and one edge point there would let the
+  // body pivot into the faces, whose points would not be in the manifold at all.
+  const double face_sep = std::max(fa.separation, fb.separation);
+  constexpr double kFaceAlignment = 0.9689124217106447;   // cos(0.25 rad): nearer than 14 degrees
+  if (edge_a >= 0 && edge_sep > clearly_beyond(face_sep) && std::abs(edge_axis.dot(n_ref)) < kFaceAlignment) {
     Vec3 cp, cq;
     if (edge_closest(s.world_a[ha.edges[edge_a][0]], s.world_a[ha.edges[edge_a][1]],
                      s.world_b[hb.edges[edge_b][0]], s.world_b[hb.edges[edge_b][1]], cp, cq)) {
@@ -177,8 +190,7 @@ int manifold(const HullEdges& ha, const Vec3& xa, const Mat3& ra, const HullEdge
     }
   }
 
-  // 3. Face contact: reference face on A unless B's is clearly less penetrating.
-  const bool flip = fb.separation > kRelative * fa.separation + kAbsolute;
+  // 4. Face contact: the reference face's side planes clip the incident face.
   const ConvexPolyhedron& ref = flip ? b : a;
   const ConvexPolyhedron& inc = flip ? a : b;
   const std::vector<Vec3>& wref = flip ? s.world_b : s.world_a;
@@ -253,7 +265,7 @@ int manifold(const HullEdges& ha, const Vec3& xa, const Mat3& ra, const HullEdge
   int found = 0;
   for (const ManifoldScratch::ClipVertex& p : s.polygon) {
     const double depth = plane - n.dot(p.x);
-    if (depth <= 0.0) continue;
+    if (depth <= -margin) continue;
     ManifoldPoint point;
     point.point = p.x + 0.5 * depth * n;
     point.normal = flip ? Vec3(-n) : n;

@@ -6,20 +6,12 @@
 #include <algorithm>
 #include <cmath>
 
+#include "graspsim/engine/contact_law.hpp"
 #include "graspsim/engine/finger_contact.hpp"
 #include "graspsim/engine/grasp_rules.hpp"
 
 namespace graspsim {
 namespace {
-
-// A contact's spring (or damper) of coefficient k: isotropic while it holds, along the normal
-// only while it slips (the tangential force then sits on the friction cone, mu f_n, and no
-// longer follows the displacement).
-Mat3 law(double k, const Vec3& n, bool slipping) {
-  return slipping ? Mat3(k * n * n.transpose()) : Mat3(k * Mat3::Identity());
-}
-
-bool finite_law(const ContactPair& p) { return std::isfinite(p.stiffness) && std::isfinite(p.damping); }
 
 std::string quoted(const std::string& s) { return "'" + s + "'"; }
 
@@ -37,24 +29,30 @@ ContactSignature contact_signature(const State& state) {
     s.floor_points.push_back(active);
     s.asleep.push_back(bs.asleep ? 1 : 0);
   }
-  for (const PairContact& pc : state.pairs) s.pair_points.push_back(pc.count);
+  for (const PairContact& pc : state.pairs) {
+    s.pair_points.push_back(pc.a);
+    s.pair_points.push_back(pc.b);
+    s.pair_points.push_back(pc.count);
+  }
   return s;
 }
 
-StabilityCheck::StabilityCheck(const Model& model) : model_(model), contacts_(model_) {}
+StabilityCheck::StabilityCheck(const Model& model, ContactGather* contacts)
+    : model_(model), own_(contacts ? nullptr : std::make_unique<ContactGather>(model_)),
+      contacts_(contacts ? contacts : own_.get()) {}
 
-std::string StabilityCheck::name(const StabilityCoupling& c) const {
-  switch (c.kind) {
-    case StabilityCoupling::Kind::kFinger: return "finger " + quoted(model_.fingers[c.finger].name);
-    case StabilityCoupling::Kind::kFloor: return "the floor under " + quoted(model_.bodies[c.b].name);
-    case StabilityCoupling::Kind::kBody:
+std::string StabilityCheck::name(const Coupling& c) const {
+  switch (c.source) {
+    case Coupling::Source::kFinger: return "finger " + quoted(model_.fingers[c.slot].name);
+    case Coupling::Source::kFloor: return "the floor under " + quoted(model_.bodies[c.b].name);
+    case Coupling::Source::kBody:
       return "the contact of " + quoted(model_.bodies[c.a].name) + " and " + quoted(model_.bodies[c.b].name);
   }
   return "?";
 }
 
-std::vector<StabilityCoupling> StabilityCheck::couplings(const State& state) {
-  std::vector<StabilityCoupling> out;
+std::vector<Coupling> StabilityCheck::couplings(const State& state) {
+  std::vector<Coupling> out;
   // Fingers: the servo force k (GO - HIP) + c (v_GO - v_HIP), with the GO riding on the body, is
   // a spring from a point fixed in the world (the HIP) to the body's material point under the GO.
   // The paper's scheme applies the mean of the window's servo forces, each computed at the pose
@@ -66,66 +64,25 @@ std::vector<StabilityCoupling> StabilityCheck::couplings(const State& state) {
     if (fs.phase == ContactPhase::kFree || fs.body < 0) continue;
     const BodyState& bs = state.bodies[fs.body];
     const ContactPair pair = finger_contact_pair(model_, static_cast<int>(f), fs.body);
-    const Vec3 n = bs.rotation * fs.normal;
-    const bool slipping = fs.phase == ContactPhase::kSlip;
-    StabilityCoupling c;
-    c.kind = StabilityCoupling::Kind::kFinger;
+    Coupling c;
+    c.source = Coupling::Source::kFinger;
     c.b = fs.body;
-    c.finger = static_cast<int>(f);
-    c.point = bs.rotation * fs.god_object + bs.position - model_.fingers[f].radius * n;
-    c.stiffness = law(pair.stiffness, n, slipping);
-    c.damping = law(model_.fingers[f].damping, n, slipping);
+    c.slot = static_cast<int>(f);
+    c.normal = bs.rotation * fs.normal;
+    c.point = bs.rotation * fs.god_object + bs.position - model_.fingers[f].radius * c.normal;
+    c.arm = c.point - bs.position;
+    c.k_n = c.k_t = pair.stiffness;
+    c.c_n = c.c_t = model_.fingers[f].damping;
+    c.slipping = fs.phase == ContactPhase::kSlip;
     out.push_back(c);
   }
-  // Floor points that touched at the last step, at the pose now, with the law the step uses
-  // (floor_pair: the implicit scheme's defaults filled in).
-  if (model_.floor.enabled) {
-    for (std::size_t b = 0; b < state.bodies.size(); ++b) {
-      const BodyState& bs = state.bodies[b];
-      const BodyParams& bp = model_.bodies[b];
-      const ContactPair pair = floor_pair(model_, static_cast<int>(b));
-      if (!finite_law(pair)) continue;
-      for (std::size_t k = 0; k < bs.floor_contacts.size(); ++k) {
-        const VertexContact& vc = bs.floor_contacts[k];
-        if (!vc.active) continue;
-        bool rolling = false;
-        StabilityCoupling c;
-        c.kind = StabilityCoupling::Kind::kFloor;
-        c.b = static_cast<int>(b);
-        c.point = bs.position + floor_point(bp.shape, bs.rotation, static_cast<int>(k), rolling);
-        c.stiffness = law(pair.stiffness, Vec3::UnitZ(), vc.slipping);
-        c.damping = law(pair.damping, Vec3::UnitZ(), vc.slipping);
-        out.push_back(c);
-      }
-    }
-  }
-  // Body pairs that touched at the last step: their manifold at the pose now, each point's
-  // slipping flag from the anchor with its key.
-  const int nb = static_cast<int>(state.bodies.size());
-  ManifoldPoint points[kMaxPairPoints];
-  for (int a = 0; a < nb; ++a) {
-    for (int b = a + 1; b < nb; ++b) {
-      const PairContact& pc = state.pairs[pair_index(a, b, nb)];
-      if (pc.count == 0) continue;
-      const ContactPair pair = body_pair(model_, a, b);
-      if (!finite_law(pair)) continue;   // both rigid: such a pair does not collide
-      const int n = contacts_.points(model_, state, a, b, points);
-      for (int i = 0; i < n; ++i) {
-        bool slipping = false;
-        for (int j = 0; j < pc.count; ++j) {
-          if (pc.points[j].key == points[i].key) slipping = pc.points[j].slipping;
-        }
-        StabilityCoupling c;
-        c.kind = StabilityCoupling::Kind::kBody;
-        c.a = a;
-        c.b = b;
-        c.point = points[i].point;
-        c.stiffness = law(pair.stiffness, points[i].normal, slipping);
-        c.damping = law(pair.damping, points[i].normal, slipping);
-        out.push_back(c);
-      }
-    }
-  }
+  // Floor points that touched at the last step and the points of the pairs that did, at the pose
+  // now, with the law the step uses (the implicit scheme's defaults filled in).
+  const std::size_t fingers = out.size();
+  contacts_->last_contacts(model_, state, out);
+  out.erase(std::remove_if(out.begin() + static_cast<std::ptrdiff_t>(fingers), out.end(),
+                           [](const Coupling& c) { return !(std::isfinite(c.k_n) && std::isfinite(c.c_n)); }),
+            out.end());
   return out;
 }
 
@@ -160,7 +117,7 @@ namespace {
 // contact_signature(state) == s, without building one.
 bool matches(const ContactSignature& s, const State& state) {
   if (s.finger_body.size() != state.fingers.size() || s.floor_points.size() != state.bodies.size() ||
-      s.pair_points.size() != state.pairs.size())
+      s.pair_points.size() != 3 * state.pairs.size())
     return false;
   for (std::size_t f = 0; f < state.fingers.size(); ++f) {
     const FingerState& fs = state.fingers[f];
@@ -173,14 +130,16 @@ bool matches(const ContactSignature& s, const State& state) {
     if (s.floor_points[b] != active || s.asleep[b] != (bs.asleep ? 1 : 0)) return false;
   }
   for (std::size_t p = 0; p < state.pairs.size(); ++p) {
-    if (s.pair_points[p] != state.pairs[p].count) return false;
+    const PairContact& pc = state.pairs[p];
+    if (s.pair_points[3 * p] != pc.a || s.pair_points[3 * p + 1] != pc.b || s.pair_points[3 * p + 2] != pc.count)
+      return false;
   }
   return true;
 }
 
 }  // namespace
 
-StabilityMonitor::StabilityMonitor(const Model& model) : check_(model) {}
+StabilityMonitor::StabilityMonitor(const Model& model, ContactGather* contacts) : check_(model, contacts) {}
 
 std::string StabilityMonitor::update(const State& state) {
   if (has_last_ && matches(last_, state)) return "";

@@ -11,6 +11,8 @@
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
 
+#include "graspsim/engine/contact_law.hpp"
+
 namespace graspsim {
 namespace {
 
@@ -100,7 +102,7 @@ std::complex<double> hinge_eigenvalue(const GroupSystem::Hinge& m, Integrator in
 }
 
 // The order of the implicit step a group takes: BDF2 under implicit_order 2 but where a grasp
-// rule's hinge acts, which takes backward Euler (implicit_step.hpp).
+// rule's hinge acts, which takes backward Euler (island_solve.hpp).
 int group_order(const GroupSystem& g, const Model& model) {
   return g.hinge_modes.empty() ? model.implicit_order : 1;
 }
@@ -163,12 +165,12 @@ bool moves(const State& state, int b) { return b >= 0 && !state.bodies[b].asleep
 
 // Bodies joined by body-body points (union-find), each group listed by its lowest body; a body
 // with no coupling is in none.
-std::vector<std::vector<int>> touching_groups(const State& state, const std::vector<StabilityCoupling>& cs) {
+std::vector<std::vector<int>> touching_groups(const State& state, const std::vector<Coupling>& cs) {
   const int nb = static_cast<int>(state.bodies.size());
   std::vector<int> parent(nb);
   for (int b = 0; b < nb; ++b) parent[b] = b;
   std::vector<std::uint8_t> coupled(nb, 0);
-  for (const StabilityCoupling& c : cs) {
+  for (const Coupling& c : cs) {
     if (moves(state, c.a)) coupled[c.a] = 1;
     if (moves(state, c.b)) coupled[c.b] = 1;
     if (moves(state, c.a) && moves(state, c.b)) parent[find_root(parent, c.a)] = find_root(parent, c.b);
@@ -188,7 +190,7 @@ std::vector<std::vector<int>> touching_groups(const State& state, const std::vec
 }
 
 // The sides of coupling c within group g: a's and b's index in it, or -1 (world, asleep, other).
-std::array<int, 2> sides(const GroupSystem& g, const State& state, const StabilityCoupling& c) {
+std::array<int, 2> sides(const GroupSystem& g, const State& state, const Coupling& c) {
   return {moves(state, c.a) ? g.local[c.a] : -1, moves(state, c.b) ? g.local[c.b] : -1};
 }
 
@@ -196,7 +198,7 @@ std::array<int, 2> sides(const GroupSystem& g, const State& state, const Stabili
 // (a: -1, b: +1) of s t J_s^T K J_t; the free directions (all six, or five under a grasp
 // hinge); W = B^T M^-1 B = L L^T; K', C'; and the hinges' own modes.
 GroupSystem assemble(const Model& model, const State& state, const std::vector<int>& bodies,
-                     const std::vector<StabilityCoupling>& cs, const std::vector<GraspHinge>& hs) {
+                     const std::vector<Coupling>& cs, const std::vector<GraspHinge>& hs) {
   GroupSystem g;
   g.bodies = bodies;
   g.local.assign(state.bodies.size(), -1);
@@ -207,10 +209,12 @@ GroupSystem assemble(const Model& model, const State& state, const std::vector<i
   // Each body's own block of the floor and body points only: what the grasp rules turn it by.
   std::vector<Eigen::Matrix<double, 6, 6>> k_rule(n, Eigen::Matrix<double, 6, 6>::Zero());
   std::vector<Eigen::Matrix<double, 6, 6>> c_rule(n, Eigen::Matrix<double, 6, 6>::Zero());
-  for (const StabilityCoupling& c : cs) {
+  for (const Coupling& c : cs) {
     const std::array<int, 2> side = sides(g, state, c);
     if (side[0] < 0 && side[1] < 0) continue;
     const int body[2] = {c.a, c.b};
+    const Mat3 stiffness = contact_matrix(c.k_n, c.normal, c.slipping);   // N/m, world
+    const Mat3 damping = contact_matrix(c.c_n, c.normal, c.slipping);     // N s/m, world
     Mat36 j[2];
     for (int s = 0; s < 2; ++s) {
       if (side[s] >= 0) j[s] = point_jacobian(c.point - state.bodies[body[s]].position);
@@ -220,12 +224,12 @@ GroupSystem assemble(const Model& model, const State& state, const std::vector<i
       for (int t = 0; t < 2; ++t) {
         if (side[t] < 0) continue;
         const double sign = (s == t) ? 1.0 : -1.0;
-        g.k6.block<6, 6>(6 * side[s], 6 * side[t]) += sign * j[s].transpose() * c.stiffness * j[t];
-        g.c6.block<6, 6>(6 * side[s], 6 * side[t]) += sign * j[s].transpose() * c.damping * j[t];
+        g.k6.block<6, 6>(6 * side[s], 6 * side[t]) += sign * j[s].transpose() * stiffness * j[t];
+        g.c6.block<6, 6>(6 * side[s], 6 * side[t]) += sign * j[s].transpose() * damping * j[t];
       }
-      if (c.kind != StabilityCoupling::Kind::kFinger) {
-        k_rule[side[s]] += j[s].transpose() * c.stiffness * j[s];
-        c_rule[side[s]] += j[s].transpose() * c.damping * j[s];
+      if (c.source != Coupling::Source::kFinger) {
+        k_rule[side[s]] += j[s].transpose() * stiffness * j[s];
+        c_rule[side[s]] += j[s].transpose() * damping * j[s];
       }
     }
   }
@@ -308,7 +312,7 @@ void add_share(std::vector<std::pair<std::string, double>>& energy, const std::s
 // larger; its motion in words and the springs that carry it (their share of q^H J^T K J q; for a
 // hinge, the floor and body points on its body). `names` are the couplings' names.
 void dominant_mode(const Model& model, const State& state, const GroupSystem& g,
-                   const std::vector<StabilityCoupling>& cs, const std::vector<std::string>& names,
+                   const std::vector<Coupling>& cs, const std::vector<std::string>& names,
                    Integrator integrator, double h, StabilityMode& mode) {
   const Eigen::Index d = g.k.rows();
   const Eigen::EigenSolver<MatrixXd> solver(one_step_map(integrator, g.k, g.c, h, group_order(g, model)), true);
@@ -330,7 +334,7 @@ void dominant_mode(const Model& model, const State& state, const GroupSystem& g,
   if (hinge) {
     mode.motion = "rotation about the grasp axis of " + quoted(model.bodies[hinge->body].name) + " (the grasp rule's)";
     for (std::size_t i = 0; i < cs.size(); ++i) {
-      if (cs[i].kind != StabilityCoupling::Kind::kFinger && (cs[i].a == hinge->body || cs[i].b == hinge->body))
+      if (cs[i].source != Coupling::Source::kFinger && (cs[i].a == hinge->body || cs[i].b == hinge->body))
         add_share(energy, names[i], 1.0);
     }
   } else if (d > 0) {
@@ -338,7 +342,7 @@ void dominant_mode(const Model& model, const State& state, const GroupSystem& g,
     const VectorXcd q = g.basis.cast<std::complex<double>>() * z;
     mode.motion = describe_motion(model, state, g.bodies, q);
     for (std::size_t i = 0; i < cs.size(); ++i) {
-      const StabilityCoupling& c = cs[i];
+      const Coupling& c = cs[i];
       const std::array<int, 2> side = sides(g, state, c);
       if (side[0] < 0 && side[1] < 0) continue;
       const int body[2] = {c.a, c.b};
@@ -348,7 +352,7 @@ void dominant_mode(const Model& model, const State& state, const GroupSystem& g,
         const Mat36 j = point_jacobian(c.point - state.bodies[body[s]].position);
         du += (s == 1 ? 1.0 : -1.0) * (j.cast<std::complex<double>>() * q.segment<6>(6 * side[s]));
       }
-      add_share(energy, names[i], std::real(du.dot(c.stiffness.cast<std::complex<double>>() * du)));
+      add_share(energy, names[i], std::real(du.dot(contact_matrix(c.k_n, c.normal, c.slipping).cast<std::complex<double>>() * du)));
     }
   }
   mode.springs = largest_shares(std::move(energy));
@@ -385,10 +389,10 @@ StabilityReport StabilityCheck::analyse(const State& state, int physics, Integra
   StabilityReport report;
   report.integrator = integrator;
   report.physics = physics;
-  const std::vector<StabilityCoupling> cs = couplings(state);
+  const std::vector<Coupling> cs = couplings(state);
   const std::vector<GraspHinge> hs = hinges(state);
   std::vector<std::string> names;
-  for (const StabilityCoupling& c : cs) names.push_back(name(c));
+  for (const Coupling& c : cs) names.push_back(name(c));
   for (const std::vector<int>& bodies : touching_groups(state, cs)) {
     const GroupSystem g = assemble(model_, state, bodies, cs, hs);
     StabilityMode mode;

@@ -1,7 +1,11 @@
 // The initial State and the sizing of per-tick records.
 #include "graspsim/engine/state.hpp"
 
-#include "graspsim/engine/object_contact.hpp"
+#include <algorithm>
+#include <utility>
+
+#include "graspsim/engine/contact_gather.hpp"
+#include "graspsim/engine/floor_points.hpp"
 #include "graspsim/engine/record.hpp"
 
 namespace graspsim {
@@ -18,10 +22,18 @@ State initial_state(const Model& model) {
     b.angular_velocity = p.angular_velocity;
     b.floor_contacts.resize(static_cast<std::size_t>(floor_point_count(p.shape)));
   }
-  const std::size_t n = model.bodies.size();
-  s.pairs.resize(n * (n > 0 ? n - 1 : 0) / 2);
   s.fingers.resize(model.fingers.size());
+  // Room for the pairs in contact (the gather's list, swapped with this one each step, has as much).
+  s.pairs.reserve(pairs_room(model.bodies.size()));
   return s;
+}
+
+const PairContact* find_pair(const State& state, int a, int b) {
+  const auto it = std::lower_bound(state.pairs.begin(), state.pairs.end(), std::make_pair(a, b),
+                                   [](const PairContact& p, const std::pair<int, int>& k) {
+                                     return p.a != k.first ? p.a < k.first : p.b < k.second;
+                                   });
+  return (it != state.pairs.end() && it->a == a && it->b == b) ? &*it : nullptr;
 }
 
 TickRecord make_tick_record(const Model& model) {
@@ -29,13 +41,9 @@ TickRecord make_tick_record(const Model& model) {
   r.servo.resize(model.fingers.size());
   r.haptic.resize(model.fingers.size());
   r.physics.resize(model.bodies.size());
-  // Room for every contact point a step can have, as Simulation reserves its couplings: each
-  // body's floor points and kMaxPairPoints per pair of bodies, so that no step allocates.
-  const std::size_t n = model.bodies.size();
-  std::size_t points = kMaxPairPoints * n * (n > 0 ? n - 1 : 0) / 2;
-  if (model.floor.enabled)
-    for (const BodyParams& bp : model.bodies) points += static_cast<std::size_t>(floor_point_count(bp.shape));
-  r.contacts.reserve(points);
+  // Room for the contact points of a step as the physics stages reserve theirs (contact_room); a
+  // step with more grows the list once, and none after.
+  r.contacts.reserve(contact_room(model));
   return r;
 }
 

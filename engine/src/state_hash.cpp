@@ -15,7 +15,7 @@ static_assert(sizeof(BodyState) == 392, "BodyState changed: update state_hash an
 static_assert(sizeof(VertexContact) == 56, "VertexContact changed: update state_hash and its test");
 static_assert(sizeof(FingerState) == 240, "FingerState changed: update state_hash and its test");
 static_assert(sizeof(Features) == 16, "Features changed: update state_hash and its test");
-static_assert(sizeof(PairContact) == 1032, "PairContact changed: update state_hash and its test");
+static_assert(sizeof(PairContact) == 1040, "PairContact changed: update state_hash and its test");
 static_assert(sizeof(PairPointContact) == 64, "PairPointContact changed: update state_hash and its test");
 #endif
 
@@ -122,8 +122,11 @@ std::uint64_t state_hash(const State& s) {
   }
   h.size(s.pairs.size());
   for (const PairContact& p : s.pairs) {
+    h.integer(p.a);
+    h.integer(p.b);
     h.integer(p.count);
-    for (const PairPointContact& q : p.points) {   // all kMaxPairPoints, used or not
+    for (int i = 0; i < p.count; ++i) {   // the points in use: a pair's list holds no others
+      const PairPointContact& q = p.points[i];
       h.word(q.key);
       h.flag(q.slipping);
       h.vec(q.anchor_a);

@@ -189,33 +189,6 @@ inline std::string hand_bandwidth(const Run& r) {
   return "the fingers did not just slide, they lost the rod: " + r.outcome.left_scene_detail();
 }
 
-// heavy_hold's 'held' box hangs from its two fingers' springs, lift - m g / (2 k) above where the
-// fingers stuck to it, which is where the floor's relief had raised it, mu k (d_l + d_r) /
-// (4 k_floor) (heavy_hold_relief's law): the hands are functions, moved by constant offsets, and
-// their squeeze sum moves by o_left.x - o_right.x, so the start by half that (mu k / (4 k_floor)
-// = 0.5): up to 0.5 mm against the expectation's 0.1 mm. Bound: that shift and the 0.1 mm.
-inline std::string heavy_hold_height(const Run& r) {
-  const std::string detail = r.outcome.expectation("5% above the threshold hangs").detail;
-  const double rose = number_after(detail, "rose ") * 1e-3, expected = number_after(detail, "expected ") * 1e-3;
-  const double shift = 0.5 * std::abs(r.outcome.jitter_offsets.at(0).at(0).x() - r.outcome.jitter_offsets.at(1).at(0).x());
-  if (std::abs(rose - expected) <= shift + 1e-4) return "";
-  return text("rose %.4f mm, more than the jittered relief (%.4f mm) from %.4f mm", rose * 1e3, shift * 1e3,
-              expected * 1e3);
-}
-
-// heavy_hold's 'held' box has 5% of friction to spare: its fingers press d = 1.05 m g / (2 mu k)
-// in. The jittered hands press d + o_left.x and d - o_right.x (heavy_hold_relief), so the
-// friction mu k (2 d + o_left.x - o_right.x) loses up to mu k 1 mm = 2.5 N of the 2.45 N spare:
-// the fingers slip where that leaves less than the weight and the lift's acceleration need
-// (the min-jerk lift's peak is 0.5 m/s^2, 5% of g: bound 1.05 m g).
-inline std::string heavy_hold_margin(const Run& r) {
-  const double g = 9.81, mass = 5.0, mu = 0.5, k = 5000.0;
-  const double d = 1.05 * mass * g / (2.0 * mu * k);
-  const double sum = 2.0 * d + r.outcome.jitter_offsets.at(0).at(0).x() - r.outcome.jitter_offsets.at(1).at(0).x();
-  if (mu * k * sum < 1.05 * mass * g) return "";
-  return text("the jittered squeeze leaves %.3f N of friction for a %.3f N box: it should hold", mu * k * sum, mass * g);
-}
-
 // rod_swing_fast swings the rod at 1.9 g; at the paper's 50 Hz step (the scenario's) the fingers
 // reach their cone at the fastest turn and slide 0.23 mm unperturbed. The offsets change each
 // pinch by up to 0.5 mm of its 15 mm and share the rod's pull unevenly between the fingers, and
@@ -304,12 +277,6 @@ inline const std::vector<Known>& known() {
       {"stack_lift", Kind::kSimPhantom, "the upper box never touched the floor",
        "the stack's centre of mass is 1 cm above the pinch's axis: an inverted pendulum the point contacts cannot hold",
        swung("lower")},
-      {"heavy_hold", Kind::kJitter, "5% above the threshold hangs",
-       "the offsets change the squeeze and the floor's relief the box is gripped at, up to 0.5 mm against 0.1 mm",
-       heavy_hold_height},
-      {"heavy_hold", Kind::kJitter, "its fingers did not slip during the lift",
-       "the held box has 5% of friction to spare, and the offsets take up to twice that from its squeeze",
-       heavy_hold_margin},
       {"rod_swing_fast", Kind::kJitter, "both still hold it at the end",
        "at 50 Hz the fingers reach their cone at the fastest turn; the offsets share the pull unevenly and they slide "
        "further, still holding", fast_swing_slide},

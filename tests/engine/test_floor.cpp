@@ -6,7 +6,9 @@
 #include <cmath>
 #include <iterator>
 
-#include "graspsim/engine/object_contact.hpp"
+#include "graspsim/engine/contact_gather.hpp"
+#include "graspsim/engine/floor_points.hpp"
+#include "graspsim/engine/paper_stage.hpp"
 #include "tests/engine/harness.hpp"
 
 using namespace graspsim;

@@ -8,7 +8,9 @@
 #include <random>
 #include <vector>
 
-#include "graspsim/engine/object_contact.hpp"
+#include "graspsim/engine/contact_gather.hpp"
+#include "graspsim/engine/floor_points.hpp"
+#include "graspsim/engine/paper_stage.hpp"
 #include "tests/engine/harness.hpp"
 #include "tests/engine/test_shape_meshes.hpp"
 
@@ -188,7 +190,7 @@ TEST_CASE("BDF2 moves a body alone, while a stack or a gyroscopic run keeps back
 }
 
 TEST_CASE("the floor's vertex screen drops only points the full test would drop", "[implicit]") {
-  // floor_couplings skips a vertex higher above the floor than any point of the body can close
+  // floor_couplings (contact_gather.hpp) skips a vertex higher above the floor than any point of the body can close
   // in the step, h (max(0, -v_z) + |w| radius) + h^2 g, before its full test, which bounds the
   // approach by the vertex's own velocity. Law: the screen changes nothing, so the couplings and
   // the anchors are the same, bit for bit, as with the screen off (radius infinite: no vertex

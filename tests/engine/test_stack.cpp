@@ -3,7 +3,9 @@
 
 #include <cmath>
 
-#include "graspsim/engine/object_contact.hpp"
+#include "graspsim/engine/contact_gather.hpp"
+#include "graspsim/engine/floor_points.hpp"
+#include "graspsim/engine/paper_stage.hpp"
 #include "tests/engine/harness.hpp"
 
 using namespace graspsim;
@@ -154,7 +156,7 @@ TEST_CASE("a box's friction stretch on a box survives a change of reference face
   m.bodies.push_back(make_box("A", 0.4, ha, Vec3(0.0, 0.0, hb.z() + ha.z() - d), Material{0.8, kInfinity, kInfinity}));
   m.bodies.push_back(make_box("B", 0.4, hb, Vec3::Zero(), Material{0.8, k, 1.0}));
   State state = initial_state(m);
-  BodyContacts contacts(m);
+  ContactGather contacts(m);
   std::vector<Wrench> wrenches(2);
   std::vector<int> points(2);
   const Vec3 base_centre(0.0, 0.0, hb.z() - d);   // A's bottom-face centre, m
@@ -163,10 +165,13 @@ TEST_CASE("a box's friction stretch on a box survives a change of reference face
     state.bodies[0].rotation = r;
     state.bodies[0].position = base_centre + Vec3(shift, 0.0, 0.0) + r * Vec3(0.0, 0.0, ha.z());
   };
+  std::vector<Coupling> couplings;
+  std::vector<int> floor_points(2);
   const auto step = [&] {
     wrenches.assign(2, Wrench{});
-    points.assign(2, 0);
-    contacts.step(m, state, wrenches, points);
+    couplings.clear();
+    contacts.gather(m, state, 0.0, couplings, floor_points, points);
+    add_pair_wrenches(m, state, couplings, wrenches);
   };
   pose(0.0, 0.0005);
   step();   // anchors where A stands
@@ -174,7 +179,7 @@ TEST_CASE("a box's friction stretch on a box survives a change of reference face
   for (int wobble = 0; wobble < 3; ++wobble) {
     for (double tilt : {0.0005, 0.005}) {
       pose(s, tilt);
-      REQUIRE(contacts.points(m, state, 0, 1, mp) == 4);
+      REQUIRE(contacts.pair_points(m, state, 0, 1, mp) == 4);
       const bool b_reference = mp[0].normal.x() == 0.0;
       CHECK(b_reference == (tilt > 0.001));   // the reference face did change
       step();

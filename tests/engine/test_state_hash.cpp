@@ -75,7 +75,9 @@ State sample_state() {
     f.has_last_physics = true;
   }
   s.pairs.resize(1);
-  s.pairs[0].count = 3;
+  s.pairs[0].a = 0;
+  s.pairs[0].b = 1;
+  s.pairs[0].count = kMaxPairPoints;   // every point in use, so that each is hashed
   std::uint64_t key = 1000;
   for (PairPointContact& p : s.pairs[0].points) {
     p.key = ++key;
@@ -156,7 +158,9 @@ std::vector<Mutation> mutations() {
     add(p + "has_last_physics", [f](State& s) { s.fingers[f].has_last_physics ^= true; });
   }
   add("fingers (one more)", [](State& s) { s.fingers.emplace_back(); });
-  add("pairs[0].count", [](State& s) { ++s.pairs[0].count; });
+  add("pairs[0].a", [](State& s) { ++s.pairs[0].a; });
+  add("pairs[0].b", [](State& s) { ++s.pairs[0].b; });
+  add("pairs[0].count", [](State& s) { --s.pairs[0].count; });
   for (int k = 0; k < kMaxPairPoints; ++k) {
     const std::string p = "pairs[0].points[" + std::to_string(k) + "].";
     add(p + "key", [k](State& s) { ++s.pairs[0].points[k].key; });
@@ -189,13 +193,26 @@ TEST_CASE("equal states hash equal, a copy or a rebuild alike", "[state_hash]") 
   CHECK(state_hash(a) != state_hash(State{}));
 }
 
+// A pair's point slots past its count hold nothing of the state (the gather fills only the points
+// it found): changing one changes no hash, so no run's hash depends on what an earlier contact left.
+TEST_CASE("a pair's unused point slots are not in its hash", "[state_hash]") {
+  State s = sample_state();
+  s.pairs[0].count = 3;
+  const std::uint64_t h0 = state_hash(s);
+  s.pairs[0].points[3].anchor_a.x() += 1.0;
+  s.pairs[0].points[kMaxPairPoints - 1].key += 1;
+  CHECK(state_hash(s) == h0);
+  s.pairs[0].points[2].key += 1;   // a point in use
+  CHECK(state_hash(s) != h0);
+}
+
 TEST_CASE("changing any one field of the state changes its hash", "[state_hash]") {
   const State base = sample_state();
   const std::uint64_t h0 = state_hash(base);
   const auto all = mutations();
   // tick, 2 bodies x 64 scalars (54 + 8 of the BDF2 history + asleep, still_steps) (+ a floor point), the body count, 2 fingers x 27, the finger
-  // count, pair count, 16 points x 8, the pair count: every field is visited.
-  REQUIRE(all.size() == 1 + 2 * 64 + 1 + 2 * 34 + 1 + 1 + 16 * 8 + 1);
+  // count, the pair's bodies a and b and its point count, 16 points x 8, the pair count: every field is visited.
+  REQUIRE(all.size() == 1 + 2 * 64 + 1 + 2 * 34 + 1 + 3 + 16 * 8 + 1);
   std::vector<std::uint64_t> seen{h0};
   for (const auto& [name, mutate] : all) {
     State s = base;

@@ -1,11 +1,12 @@
-// A contact point as the implicit step sees it (implicit_step.hpp solves them; object_contact.hpp
-// and the simulation gather them): the force it exerts and how that force changes as the bodies
-// move over the step.
+// A contact point as every stage sees it: gathered once a physics step (contact_gather.hpp for the
+// floor and between bodies, the implicit stage for fingers), then clamped by the paper's step,
+// solved by the implicit step (island_solve.hpp), turned into springs by the stability check.
 #pragma once
 
 #include <cstdint>
 
 #include "graspsim/engine/math.hpp"
+#include "graspsim/engine/model.hpp"
 
 namespace graspsim {
 
@@ -28,20 +29,27 @@ struct Coupling {
   enum class Source : std::uint8_t { kFinger, kFloor, kBody };
   Source source = Source::kFinger;
   int slot = -1;                   // the source's index: finger, floor point, or point of the pair
+  int pair = -1;                   // kBody: the pair's index in State::pairs
   int a = -1;                      // body pushed by -f, or -1 for the world (floor, a finger's HIP)
   int b = -1;                      // body pushed by +f
   Vec3 point{0.0, 0.0, 0.0};       // m, world: where the force acts
+  Vec3 arm{0.0, 0.0, 0.0};         // m, world: from b's centre of mass to the point
   Vec3 normal{0.0, 0.0, 1.0};      // 1, world, unit: the direction in which the normal force pushes b
   Vec3 world_velocity{0.0, 0.0, 0.0};   // m/s, world: the world side's velocity over the step when
                                         //    a = -1 (a finger's HIP, taken to go on as over the last
                                         //    window; 0 for the floor)
   Vec3 force{0.0, 0.0, 0.0};       // N, world, on b: at the start of the step (floor and body
                                    //    points: the penalty law unclamped, so that it extends linearly)
+  double normal_force = 0.0;       // N: floor and body points: the law's normal part, unclamped
+  Vec3 tangential_force{0.0, 0.0, 0.0};   // N, world: floor and body points: its tangential part
+  double depth = kInfinity;        // m: overlap at the start of the step (< 0: a point the step may
+                                   //    reach); infinite for a finger
   double k_n = 0.0, c_n = 0.0;     // N/m, N s/m: along the normal
   double k_t = 0.0, c_t = 0.0;     // N/m, N s/m: across it
   double lead = 0.0;               // s: how far ahead of the step's poses the force is measured
   double mu = -1.0;                // 1: friction limit |f_t| <= mu f_n + viscous; < 0 for none
   double viscous = 0.0;            // N: viscous sliding force c |u_t| at the start (while slipping)
+  bool slipping = false;           // floor and body points: the anchor slid at the last step
 };
 
 // What the solve decided for a coupling.

@@ -25,7 +25,7 @@ inline bool friction_circle_step(const Vec3& sp, double radius, Vec3& go) {
 }
 
 // Coulomb's limit on a tangential force: scaled down onto |f_t| = limit when it is over it.
-// Floor points and body points (object_contact.cpp) take their friction force through it.
+// Floor points and body points (contact_law.hpp) take their friction force through it.
 inline void clamp_to_cone(double limit, Vec3& f_t) {
   const double f_t_norm = f_t.norm();
   if (f_t_norm > limit) f_t *= limit / f_t_norm;

@@ -53,7 +53,7 @@ void integrate_body(const BodyParams& params, Gyroscopic gyroscopic, BodyState& 
 // scenarios at 50 Hz.) The gyroscopic change, if any, is in w0 already (gyroscopic_change()).
 void move_body(const BodyParams& params, BodyState& body, const Vec3& force, const Vec3& torque, double dt);
 
-// The BDF2 move, the displacement the second-order solve assumed (implicit_step.hpp): the body
+// The BDF2 move, the displacement the second-order solve assumed (island_solve.hpp): the body
 // takes the end velocities v1, w1 (m/s, rad/s, world) and moves by
 //   p = p + dt (v_mean + 2 v1) / 3      R = exp(S(dt (w_mean + 2 w1) / 3)) R_old
 // where v_mean, w_mean are the last step's displacement rates. Under constant force this is

@@ -58,6 +58,6 @@ inline constexpr int kMaxManifoldPoints = 16;
 // that form a face of the Minkowski difference are tested (Gregorius' Gauss-map test): an edge
 // lying on the other body's face is a face contact, never an edge contact that flickers with it.
 int manifold(const HullEdges& a, const Vec3& xa, const Mat3& ra, const HullEdges& b, const Vec3& xb,
-             const Mat3& rb, ManifoldScratch& scratch, ManifoldPoint* out, int capacity);
+             const Mat3& rb, ManifoldScratch& scratch, ManifoldPoint* out, int capacity, double margin = 0.0);
 
 }  // namespace graspsim

@@ -157,7 +157,7 @@ struct Model {
   SleepParams sleep;
   Integrator integrator = Integrator::kPaper;
   int implicit_order = 2;     // under kImplicit: 2, BDF2 restarted by backward Euler wherever an
-                              // island's contacts change (implicit_step.hpp); 1, backward Euler
+                              // island's contacts change (island_solve.hpp); 1, backward Euler
   bool local_model = false;   // under kImplicit: the fast loops see each body move on between
                               // physics steps (local_model.hpp); else they see its last pose
   Gyroscopic gyroscopic = Gyroscopic::kNeglect;

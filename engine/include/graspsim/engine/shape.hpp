@@ -1,6 +1,6 @@
 // Shapes of bodies, in the body frame (origin at the centre of mass, axes along the principal
 // axes of inertia). Parameters only: the queries live in collision, finger_contact and
-// object_contact.
+// the contact gather (contact_gather.hpp, floor_points.hpp, narrowphase).
 #pragma once
 
 #include <array>

@@ -6,10 +6,10 @@
 #include <vector>
 
 #include "graspsim/engine/collision.hpp"
-#include "graspsim/engine/grasp_rules.hpp"
-#include "graspsim/engine/implicit_step.hpp"
+#include "graspsim/engine/contact_gather.hpp"
+#include "graspsim/engine/implicit_stage.hpp"
 #include "graspsim/engine/model.hpp"
-#include "graspsim/engine/object_contact.hpp"
+#include "graspsim/engine/paper_stage.hpp"
 #include "graspsim/engine/record.hpp"
 #include "graspsim/engine/state.hpp"
 
@@ -27,15 +27,16 @@ class Simulation {
   //              the contact point on the surface (GO less the pad radius), is added to the
   //              contacted body's physics window
   //   4 physics  (tick % (servo/physics) == 0), over dt = 1/physics s, by Model::integrator:
-  //              paper     body-body contact wrenches for every pair in contact, all at the state
-  //                        of this tick; then for every body, in body order: record the state at
-  //                        this tick; residual F = finger impulse over the window / dt + floor +
-  //                        other bodies + m g and T likewise; grasp rules, dead band; integrate
-  //              implicit  every contact point (fingers, floor, body pairs) as a spring-damper
-  //                        about this tick's state; each island of touching bodies solved at once
-  //                        for its velocities at the end of the step; then for every body, in
+  //              one gather of every contact point (contact_gather.hpp), then
+  //              paper     each point's force clamped, all at the state of this tick; then for
+  //                        every body, in body order: record the state at this tick; residual
+  //                        F = finger impulse over the window / dt + floor + other bodies + m g
+  //                        and T likewise; grasp rules, dead band; integrate (paper_stage.hpp)
+  //              implicit  every point (fingers too) a spring-damper about this tick's state;
+  //                        the islands of bodies that push on each other solved at once for
+  //                        their velocities at the end of the step; then for every body, in
   //                        body order: record; the solved change as F and T; grasp rules, dead
-  //                        band; move (backward Euler, exact turn)
+  //                        band; move (backward Euler or BDF2, exact turn) (implicit_stage.hpp)
   //              then per body: clear the window; flag a body whose state diverged (record.hpp)
   //   5 tick += 1
   // Time is tick / servo, computed, never accumulated.
@@ -69,6 +70,13 @@ class Simulation {
   void record_contacts(bool on) { record_contacts_ = on; }
   bool records_contacts() const { return record_contacts_; }
   std::int64_t tick() const { return state_.tick; }
+  // The contact points of the last physics step, as gathered (paper) or solved (implicit).
+  const std::vector<Coupling>& contact_points() const {
+    return model_.integrator == Integrator::kPaper ? paper_.couplings() : implicit_.couplings();
+  }
+  // The gather the physics stage uses, for read-only queries at the state now (the stability
+  // check's), so that a run has one FCL world.
+  ContactGather& contacts() { return contacts_; }
   double time() const { return static_cast<double>(state_.tick) / model_.rates.servo; }   // s
 
  private:
@@ -79,18 +87,6 @@ class Simulation {
   // The physics stage's parts.
   double gimbal_pitch_change(const Input& input);
   void wake_touched_bodies();
-  void paper_contacts(TickRecord& record);
-  void paper_body_step(int b, double pitch_change, TickRecord& record);
-  void implicit_contacts(const Input& input);
-  void implicit_solve(double pitch_change);
-  void record_implicit_contacts(TickRecord& record) const;
-  void implicit_body_step(int b, TickRecord& record);
-  void record_sleeping(int b, TickRecord& record);
-  BodyRecord& record_state(int b, int floor_contacts, TickRecord& record);
-  void apply_grasp_rules(int b, double pitch_change, const Wrench& contact, BodyState& bs, Vec3& torque,
-                         BodyRecord& rec);
-  void mark_stepped(BodyState& bs) const;
-  void finish_body_step(int b, TickRecord& record);
 
   Model model_;
   bool record_contacts_ = false;
@@ -100,35 +96,14 @@ class Simulation {
   // remainders by the divisors, kept by counting. (Two 64-bit divisions a tick cost an idle servo
   // tick as much as the rest of its work.) Only step() moves the clock, so they cannot drift.
   std::int64_t to_haptic_ = 0, to_physics_ = 0;
-  std::shared_ptr<detail::FclWorld> fcl_;   // the bodies' FCL objects, one world for both below
+  std::shared_ptr<detail::FclWorld> fcl_;   // the bodies' FCL objects, one world for the fingers and the bodies
   CollisionWorld collision_;
   bool collision_stale_ = false;   // bodies moved since collision_ was last updated
-  std::vector<int> scratch_;   // candidate bodies of a finger query
-  BodyContacts body_contacts_;            // body-body contact (its own broadphase)
-  std::vector<Wrench> contact_wrench_;    // per body: the contact wrench the grasp rules see (paper:
-                                          //   body-body, the floor's added per body; implicit: floor
-                                          //   and bodies at the start of the step, pushing only)
-  std::vector<int> contact_points_;       // per body: body-body contact points of this step
-  std::vector<double> floor_reach_;       // m, per body: farthest floor point from the centre of mass
-  std::vector<ContactPair> floor_pairs_;  // per body, with a floor: its pair with the floor (constant)
-  std::vector<std::uint8_t> floor_clear_;  // per body: 1 when none of its floor points is active
-  // The implicit step's buffers (sized once).
-  ImplicitStep implicit_;
-  StepHistory history_;                   // per body: what the BDF2 step needs of the last step
-  std::vector<Coupling> couplings_;       // this step's contact points
-  std::vector<std::uint8_t> awake_;       // per body: 1 when stepped
-  std::vector<Vec3> v0_, w0_;             // m/s, rad/s, per body: velocities at the start of the step
-                                          //   (w0 after the gyroscopic change)
-  std::vector<Vec3> external_force_;      // N, per body: fingers' window mean and gravity
-  std::vector<Vec3> external_torque_;     // N m, per body: fingers' window mean
-  std::vector<int> floor_points_;         // per body: floor points pushing at the end of the step
-  std::vector<Vec3> finger_point_;        // m, world, per finger: contact point of this servo tick
-  std::vector<Vec3> finger_force_;        // N, world, per finger: force on the finger this servo tick
-  std::vector<AxisRule> rules_;           // per body: its grasp rule this step
-  std::vector<std::uint8_t> axis_active_; // per body: 1 when a rule holds its rate about an axis
-  std::vector<Vec3> axis_;                // 1, world, per body: that axis
-  std::vector<Vec3> axis_point_;          // m, world, per body: a point of it (the first god-object)
-  std::vector<double> axis_rate_;         // rad/s, per body: the rate about it at the end of the step
+  std::vector<int> scratch_;       // candidate bodies of a finger query
+  std::vector<Vec3> finger_point_; // m, world, per finger: contact point of this servo tick
+  ContactGather contacts_;         // every contact point of the bodies, once a physics step
+  PaperStage paper_;               // the integrators, each with what only it needs
+  ImplicitStage implicit_;
 };
 
 }  // namespace graspsim

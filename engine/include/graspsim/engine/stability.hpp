@@ -8,6 +8,7 @@
 #pragma once
 
 #include <complex>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -15,7 +16,8 @@
 
 #include "graspsim/engine/math.hpp"
 #include "graspsim/engine/model.hpp"
-#include "graspsim/engine/object_contact.hpp"
+#include "graspsim/engine/contact_gather.hpp"
+#include "graspsim/engine/coupling.hpp"
 #include "graspsim/engine/state.hpp"
 
 namespace graspsim {
@@ -35,7 +37,7 @@ inline constexpr double kUnstableRadius = 1.0 + 1e-6;
 // C' = L^T C L (same eigenvalues, better conditioned), and the state is (z, y = h z'), both in
 // the same units. One step of length h:
 //   kPaper (symplectic Euler, integrate.cpp):   y1 = (I - h C') y0 - h^2 K' z0,   z1 = z0 + y1
-//   kImplicit (linearised backward Euler, implicit_step.hpp: the pose moves by h v1):
+//   kImplicit (linearised backward Euler, island_solve.hpp: the pose moves by h v1):
 //     S y1 = y0 - h^2 K' z0,  S = I + h C' + h^2 K',   z1 = z0 + y1
 // The map is the 2n x 2n matrix A with (z1, y1) = A (z0, y0).
 //   kImplicit with implicit_order 2 (BDF2, its restarts aside):
@@ -57,19 +59,11 @@ double paper_radius_1d(double k_over_m, double c_over_m, double h);
 
 // ---- couplings of a state ----
 
-// One spring-damper between two bodies (or a body and the world) at a point: its force on b is
-// -K du - C du' where du is b's material displacement at the point relative to a's; the
-// velocity of a body's point is v + w x r, r from its centre of mass (J = [I, -skew(r)]).
-struct StabilityCoupling {
-  enum class Kind { kFinger, kFloor, kBody };
-  Kind kind = Kind::kFinger;
-  int a = -1;                      // body pushed by -f, or -1 (the world: a HIP, the floor)
-  int b = -1;                      // body pushed by +f
-  int finger = -1;                 // Model::fingers index for kFinger
-  Vec3 point{0.0, 0.0, 0.0};       // m, world
-  Mat3 stiffness = Mat3::Zero();   // N/m, world
-  Mat3 damping = Mat3::Zero();     // N s/m, world
-};
+// The couplings are the contact points as every stage sees them (coupling.hpp): a spring-damper
+// between two bodies (or a body and the world) at a point, whose force on b is -K du - C du' where
+// du is b's material displacement at the point relative to a's; the velocity of a body's point is
+// v + w x r, r from its centre of mass (J = [I, -skew(r)]). K and C from contact_matrix(): k I while
+// the point holds, k n n^T while it slips.
 
 // The rotation about a two-finger grasp axis that the grasp rules drive instead of the springs
 // (grasp_rules.hpp): through `point` along unit `axis`, world.
@@ -116,19 +110,26 @@ struct ContactSignature {
   std::vector<int> finger_phase;    // per finger: ContactPhase as an int
   std::vector<int> floor_points;    // per body: active floor points
   std::vector<int> asleep;          // per body: 1 when sleeping
-  std::vector<int> pair_points;     // per body pair (pair_index): points at the last step
+  std::vector<int> pair_points;     // per pair of State::pairs: its bodies and points at the last step
   bool operator==(const ContactSignature&) const = default;
 };
 ContactSignature contact_signature(const State& state);
 
 class StabilityCheck {
  public:
-  explicit StabilityCheck(const Model& model);
+  // With `contacts`, the points of touching pairs come from that gather (a Simulation's: one FCL
+  // world a run); without, from one of its own.
+  explicit StabilityCheck(const Model& model, ContactGather* contacts = nullptr);
   const Model& model() const { return model_; }
+  // The points of touching pairs from `contacts` from now on (its own gather is dropped).
+  void use_contacts(ContactGather& contacts) {
+    contacts_ = &contacts;
+    own_.reset();
+  }
 
   // Every coupling at `state`, in a fixed order: fingers, then floor points body by body, then
-  // body pairs; and the hinges the grasp rules impose.
-  std::vector<StabilityCoupling> couplings(const State& state);
+  // body pairs (the gather's last_contacts); and the hinges the grasp rules impose.
+  std::vector<Coupling> couplings(const State& state);
   std::vector<GraspHinge> hinges(const State& state) const;
 
   // The map of every group at `state` under the model's integrator and physics rate, or the
@@ -138,11 +139,12 @@ class StabilityCheck {
 
   // A short name of a coupling for a sentence: "finger 'thumb'", "the floor under 'box'",
   // "the contact of 'a' and 'b'".
-  std::string name(const StabilityCoupling& c) const;
+  std::string name(const Coupling& c) const;
 
  private:
   Model model_;
-  BodyContacts contacts_;   // its own, for the points of touching pairs
+  std::unique_ptr<ContactGather> own_;   // when no gather was given
+  ContactGather* contacts_;
 };
 
 // The check over a run: after each physics tick, the state is analysed again when its contact
@@ -150,7 +152,8 @@ class StabilityCheck {
 // met again (the same bodies on the same springs, at another radius or pose) gives none.
 class StabilityMonitor {
  public:
-  explicit StabilityMonitor(const Model& model);
+  explicit StabilityMonitor(const Model& model, ContactGather* contacts = nullptr);
+  void use_contacts(ContactGather& contacts) { check_.use_contacts(contacts); }
 
   // Returns the warning for `state` if its analysis is unstable and that mode was not warned
   // of before, else "". Cheap when the signature is unchanged (a comparison, no allocation).

@@ -69,17 +69,12 @@ struct PairPointContact {
 
 inline constexpr int kMaxPairPoints = 16;   // contact points kept per body pair
 
-// The contact of two bodies A < B (by index).
+// The contact of two bodies a < b (by index) at the last physics step: its points' anchors.
 struct PairContact {
-  int count = 0;                                       // points in contact at the last step
+  int a = 0, b = 0;                                    // body indices, a < b
+  int count = 0;                                       // points found at the last step (> 0)
   std::array<PairPointContact, kMaxPairPoints> points{};
 };
-
-// Index of the pair (a, b), a < b, among n bodies in State::pairs: (0,1), (0,2), ..., (1,2), ...
-inline std::size_t pair_index(int a, int b, int n) {
-  return static_cast<std::size_t>(a) * static_cast<std::size_t>(2 * n - a - 1) / 2 +
-         static_cast<std::size_t>(b - a - 1);
-}
 
 struct BodyState {
   Vec3 position{0.0, 0.0, 0.0};           // m: centre of mass, world
@@ -92,7 +87,7 @@ struct BodyState {
   Vec3 position_before_step{0.0, 0.0, 0.0};       // m, world
   Mat3 rotation_before_step = Mat3::Identity();   // 1: body to world
   std::int64_t stepped_at = -1;                   // servo tick of the last physics step (-1: none)
-  // The last implicit step, for the next one's BDF2 (implicit_step.hpp, StepHistory): the
+  // The last implicit step, for the next one's BDF2 (island_solve.hpp, StepHistory): the
   // velocities at its start, and its island's couplings and their modes (0: none, a restart).
   Vec3 velocity_before_step{0.0, 0.0, 0.0};           // m/s, world
   Vec3 angular_velocity_before_step{0.0, 0.0, 0.0};   // rad/s, world
@@ -100,7 +95,7 @@ struct BodyState {
   int island_steps = 0;                               // 1: physics steps in a row with that signature
   bool asleep = false;       // sleeping: not stepped, pose frozen, velocities zero (Model::sleep)
   int still_steps = 0;       // 1: physics steps in a row with |v| and |w| under the sleep thresholds
-  std::vector<VertexContact> floor_contacts;   // one per floor point of the shape (object_contact.hpp),
+  std::vector<VertexContact> floor_contacts;   // one per floor point of the shape (floor_points.hpp),
                                                // sized by initial_state
   // Finger wrench accumulated over the current physics window (sum over servo ticks).
   Vec3 window_force{0.0, 0.0, 0.0};       // N (summed; divided by servo/physics ticks)
@@ -111,8 +106,13 @@ struct State {
   std::int64_t tick = 0;              // servo ticks done; time = tick / servo rate
   std::vector<BodyState> bodies;      // same order as Model::bodies
   std::vector<FingerState> fingers;   // same order as Model::fingers
-  std::vector<PairContact> pairs;     // every body pair a < b, at pair_index(a, b, bodies)
+  std::vector<PairContact> pairs;     // the pairs of bodies with contact points at the last physics
+                                      // step, sorted by (a, b): memory grows with the contacts, not
+                                      // with the square of the bodies
 };
+
+// The contact of bodies a < b in `state.pairs`, or nullptr when they had no points at the last step.
+const PairContact* find_pair(const State& state, int a, int b);
 
 // Wakes a sleeping body (no-op when awake): it is stepped again from rest, counting anew.
 inline void wake(BodyState& body) {
