@@ -17,6 +17,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <ctime>
 #include <fstream>
 #include <new>
 #include <sstream>
@@ -45,6 +46,21 @@ struct Options {
   bool sleep = false;
   bool verbose = false;
 };
+
+double median(std::vector<double> v) {
+  if (v.empty()) return NAN;
+  std::sort(v.begin(), v.end());
+  const std::size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+// us of CPU time this thread has used: unlike the wall time, not counting the time the
+// scheduler gave other processes (the step is timed on a shared machine).
+double thread_cpu_us() {
+  timespec ts{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return 1e6 * static_cast<double>(ts.tv_sec) + 1e-3 * static_cast<double>(ts.tv_nsec);
+}
 
 // ---- the child: one run --------------------------------------------------------------------
 
@@ -137,8 +153,9 @@ void step_statistics(std::vector<double> us) {
 // the states are read after every step (energy, height, finiteness), as a user's loop reads poses.
 bool run_once(const std::string& engine, const Scene& scene, double duration, bool last) {
   const int planned = std::max(1, static_cast<int>(std::llround(duration / scene.dt)));
-  std::vector<double> us;
+  std::vector<double> us, cpu_us;   // us: wall and this thread's CPU time of each step
   us.reserve(static_cast<std::size_t>(planned));
+  cpu_us.reserve(static_cast<std::size_t>(planned));
   std::vector<BoxState> start, now;
   start.reserve(scene.boxes.size());
   now.reserve(scene.boxes.size());
@@ -151,9 +168,11 @@ bool run_once(const std::string& engine, const Scene& scene, double duration, bo
   g_record.energy_start = energy(start);
   double energy_max = g_record.energy_start;   // J
   for (int k = 0; k < planned; ++k) {
+    const double c0 = thread_cpu_us();
     const auto t0 = std::chrono::steady_clock::now();
     world->step();
     const auto t1 = std::chrono::steady_clock::now();
+    cpu_us.push_back(thread_cpu_us() - c0);
     us.push_back(std::chrono::duration<double, std::micro>(t1 - t0).count());
     g_record.steps = k + 1;
     if (!last && world->out_of_room()) break;
@@ -168,6 +187,7 @@ bool run_once(const std::string& engine, const Scene& scene, double duration, bo
   g_record.rss_mb = (status_kb("VmHWM:") - rss_before) / 1024.0;
   g_record.energy_rise = energy_max - g_record.energy_start;
   if (!g_record.failed[0]) end_outcome(start, now);
+  g_record.cpu_us_median = median(cpu_us);
   step_statistics(std::move(us));
   const std::string trouble = world->trouble();
   if (!trouble.empty()) set_failed(g_record.failed[0] ? std::string(g_record.failed) + "; " + trouble : trouble);
@@ -240,13 +260,6 @@ Record run_in_child(const std::string& engine, const Scene& scene, double durati
   return record;
 }
 
-double median(std::vector<double> v) {
-  if (v.empty()) return NAN;
-  std::sort(v.begin(), v.end());
-  const std::size_t n = v.size();
-  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
-
 // One row: the step times are the median over repeats of each run's median, min and max; the
 // outcome is the first run's (each engine here is deterministic, every repeat computes the same
 // states: a difference is reported on stderr); a run that failed makes the row failed.
@@ -255,13 +268,14 @@ struct Row {
   int n = 0, rate = 0, steps = 0;
   double gap = 0, duration = 0;
   Record outcome;
-  double us_median = NAN, us_min = NAN, us_max = NAN, rss_mb = NAN;
+  double us_median = NAN, us_min = NAN, us_max = NAN, rss_mb = NAN;   // us, MB
+  double cpu_us_median = NAN;                                         // us: the table's, not the CSV's
 };
 
 Row combine(const std::vector<Record>& runs) {
   Row row;
   row.outcome = runs.front();
-  std::vector<double> med, lo, hi, rss;
+  std::vector<double> med, lo, hi, rss, cpu;
   for (const Record& r : runs) {
     if (r.failed[0] && row.failed == "no") row.failed = r.failed;
     if (r.steps == 0) continue;
@@ -269,6 +283,7 @@ Row combine(const std::vector<Record>& runs) {
     lo.push_back(r.us_min);
     hi.push_back(r.us_max);
     rss.push_back(r.rss_mb);
+    cpu.push_back(r.cpu_us_median);
     const Record& a = row.outcome;
     if (r.steps != a.steps || r.energy_rise != a.energy_rise || r.drift_end != a.drift_end || r.thrown != a.thrown)
       std::fprintf(stderr, "graspsim_peers: the repeats' outcomes differ; the first one's is reported\n");
@@ -278,6 +293,7 @@ Row combine(const std::vector<Record>& runs) {
   row.us_min = median(lo);
   row.us_max = median(hi);
   row.rss_mb = median(rss);
+  row.cpu_us_median = median(cpu);
   return row;
 }
 
@@ -288,16 +304,17 @@ constexpr const char* kCsvHeader =
     "energy_start_j,energy_rise_j,drift_end_m,speed_end_ms,thrown_m,failed";
 
 void print_table_header() {
-  std::printf("%-7s %-8s %5s %5s %6s %10s %21s %8s %7s %9s %9s %8s %9s %8s  %s\n", "engine", "layout", "n", "Hz",
-              "steps", "us/step", "(min - max)", "us/body", "RSS MB", "E0 J", "rise J", "drift m", "speed m/s",
-              "thrown m", "failed");
+  std::printf("%-7s %-8s %5s %5s %6s %10s %21s %8s %9s %7s %9s %9s %8s %9s %8s  %s\n", "engine", "layout", "n",
+              "Hz", "steps", "us/step", "(min - max)", "us/body", "cpu us", "RSS MB", "E0 J", "rise J", "drift m",
+              "speed m/s", "thrown m", "failed");
 }
 
 void print_table_row(const Row& r) {
   char range[64];
   std::snprintf(range, sizeof range, "(%.1f - %.1f)", r.us_min, r.us_max);
-  std::printf("%-7s %-8s %5d %5d %6d %10.1f %21s %8.3f %7.2f %9.2f %9.3g %8.3g %9.3g %8.3g  %s\n", r.engine.c_str(),
-              r.layout.c_str(), r.n, r.rate, r.steps, r.us_median, range, r.us_median / r.n, r.rss_mb,
+  std::printf("%-7s %-8s %5d %5d %6d %10.1f %21s %8.3f %9.1f %7.2f %9.2f %9.3g %8.3g %9.3g %8.3g  %s\n",
+              r.engine.c_str(), r.layout.c_str(), r.n, r.rate, r.steps, r.us_median, range, r.us_median / r.n,
+              r.cpu_us_median, r.rss_mb,
               r.outcome.energy_start, r.outcome.energy_rise, r.outcome.drift_end, r.outcome.speed_end,
               r.outcome.thrown, r.failed.c_str());
   std::fflush(stdout);

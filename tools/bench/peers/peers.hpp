@@ -56,6 +56,7 @@ struct Record {
   double us_median = 0.0;         // us: wall time of one step, median over the run's steps
   double us_min = 0.0;            // us
   double us_max = 0.0;            // us
+  double cpu_us_median = 0.0;     // us: this thread's CPU time of one step, median over the run's steps
   double rss_mb = 0.0;            // MB (2^20 B): peak RSS growth from before the World was built
   double energy_start = 0.0;      // J: E at t = 0
   double energy_rise = 0.0;       // J: max over the run of E(t) - E(0), >= 0
