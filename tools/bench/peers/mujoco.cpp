@@ -66,9 +66,10 @@ class MujocoWorld final : public World {
     char error[1000] = "";
     model_ = mj_loadXML("scale.xml", vfs.get(), error, sizeof error);
     mj_deleteVFS(vfs.get());
-    if (!model_) throw std::runtime_error(std::string("mujoco: MJCF refused: ") + error);
+    const std::string arena = scene.room > 0 ? " (arena for " + std::to_string(scene.room) + " contacts a box)" : "";
+    if (!model_) throw std::runtime_error("mujoco: MJCF refused" + arena + ": " + error);
     data_ = mj_makeData(model_);
-    if (!data_) throw std::runtime_error("mujoco: mj_makeData failed");
+    if (!data_) throw std::runtime_error("mujoco: mj_makeData failed" + arena);
     mj_forward(model_, data_);
   }
 
