@@ -3,7 +3,8 @@
 // hello-world example does:
 //  - btDiscreteDynamicsWorld with btDefaultCollisionConfiguration, btCollisionDispatcher,
 //    btDbvtBroadphase and btSequentialImpulseConstraintSolver, the solver's defaults (10
-//    iterations, split impulse off, warm starting on);
+//    iterations, warm starting 0.85; a contact's penetration corrected through its velocity
+//    with ERP 0.2 down to 4 cm deep, by split impulse past that);
 //  - each box a btBoxShape of half extent 5 cm with its default collision margin: 0.04 m cut to
 //    a tenth of the smallest half extent by the shape's setSafeMargin, so 5 mm, inside the
 //    extents (the box is its full size); mass 1 kg, inertia from the shape (m s^2 / 6);
