@@ -30,8 +30,8 @@
 namespace graspsim::bench::peers {
 namespace {
 
-constexpr rlim_t kChildAddressSpace = rlim_t{8} << 30;   // B: a run past this fails out of memory
-                                                          // instead of crowding the machine
+constexpr double kChildGrowth = 8.0 * (1 << 30);   // B of address space a run may add: past it, it
+                                                   // fails out of memory instead of crowding the machine
 
 struct Options {
   std::vector<std::string> engines{"ode", "mujoco", "bullet"};
@@ -230,7 +230,9 @@ Record run_in_child(const std::string& engine, const Scene& scene, double durati
   if (pid == 0) {
     close(fds[0]);
     g_pipe = fds[1];
-    const rlimit limit{kChildAddressSpace, kChildAddressSpace};
+    // Counted from the address space the child has (a sanitizer build reserves terabytes).
+    const auto most = static_cast<rlim_t>(1024.0 * status_kb("VmSize:") + kChildGrowth);
+    const rlimit limit{most, most};
     setrlimit(RLIMIT_AS, &limit);
     try {
       measure(engine, scene, duration);
