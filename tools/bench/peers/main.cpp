@@ -280,7 +280,7 @@ Row combine(const std::vector<Record>& runs) {
   std::vector<double> med, lo, hi, rss, cpu;
   for (const Record& r : runs) {
     if (r.failed[0] && row.failed == "no") row.failed = r.failed;
-    if (r.steps == 0) continue;
+    if (r.steps == 0 || r.us_median <= 0) continue;   // ended before its times were summed
     med.push_back(r.us_median);
     lo.push_back(r.us_min);
     hi.push_back(r.us_max);
