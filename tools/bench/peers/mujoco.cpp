@@ -4,11 +4,12 @@
 // 0.6 for every contact; its torsional and rolling terms are unused at the default condim 3).
 // Everything else is MuJoCo's default: <option timestep = 1/rate> only, so the Euler
 // integrator, the Newton solver (100 iterations, tolerance 1e-8), pyramidal friction cones,
-// soft contacts with the default solref (0.02 s, damping ratio 1) and solimp, and <size>
-// unset, so the arena (nstack, njmax, nconmax) is whatever MuJoCo sizes for the model.
-// A step is mj_step. What MuJoCo counts as a warning (too many contacts or constraints, a bad
-// qacc, after which mj_step resets the data to the model's start) is the run's trouble; an
-// mju_error (the stack allocator out of its arena) fails the run.
+// soft contacts with the default solref (0.02 s, damping ratio 1) and solimp. The contact list
+// and the arena (nconmax, njmax, nstack) are MuJoCo's default for Scene::room 0, and
+// <size nconmax = room n, njmax = 4 room n> otherwise (main.cpp raises room while contacts are
+// dropped). A step is mj_step. What MuJoCo counts as a warning (too many contacts or
+// constraints, a bad qacc, after which mj_step resets the data to the model's start) is the
+// run's trouble; an mju_error (an allocation or the stack allocator out of its arena) fails it.
 #include <mujoco/mujoco.h>
 
 #include <cmath>
