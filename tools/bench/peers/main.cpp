@@ -1,6 +1,7 @@
-// graspsim_peers: the scale scenes (bench/scale_scenes.hpp) stepped in ODE, MuJoCo and Bullet,
-// each engine as its defaults have it, timed per step, with the outcome graspsim's own scale
-// benchmark is judged by (tools/bench/README.md, "Peers"). Links no graspsim library.
+// graspsim_peers: the scale scenes (bench/scale_scenes.hpp) stepped in graspsim and in ODE,
+// MuJoCo and Bullet (where their packages are), each engine as its defaults have it, timed per
+// step, each judged by the same outcome: energy, drift, rest, thrown (tools/bench/README.md,
+// "Peers"). graspsim's engine is one more World (graspsim.cpp); the peers know nothing of it.
 //
 // Each (engine, layout, n, rate) is run --repeats times, each time in a child process of its
 // own (fork), so that a run's peak RSS growth is that scene's alone (a process that ran a
@@ -33,8 +34,23 @@ namespace {
 constexpr double kChildGrowth = 8.0 * (1 << 30);   // B of address space a run may add: past it, it
                                                    // fails out of memory instead of crowding the machine
 
+// The engines this build can run: graspsim always; the peers where their packages were found.
+std::vector<std::string> available_engines() {
+#if GRASPSIM_PEERS
+  return {"graspsim", "ode", "mujoco", "bullet"};
+#else
+  return {"graspsim"};
+#endif
+}
+
+std::string join(const std::vector<std::string>& items) {
+  std::string out;
+  for (const std::string& item : items) out += (out.empty() ? "" : ",") + item;
+  return out;
+}
+
 struct Options {
-  std::vector<std::string> engines{"ode", "mujoco", "bullet"};
+  std::vector<std::string> engines = available_engines();
   std::vector<scale::Layout> layouts{scale::Layout::kApart, scale::Layout::kIsland, scale::Layout::kTower,
                                      scale::Layout::kPyramid, scale::Layout::kPile};
   std::vector<int> n{16, 64, 144, 400, 1000};
@@ -119,9 +135,12 @@ bool finite(const std::vector<BoxState>& boxes) {
 }
 
 std::unique_ptr<World> make_world(const std::string& engine, const Scene& scene) {
+  if (engine == "graspsim") return make_graspsim_world(scene);
+#if GRASPSIM_PEERS
   if (engine == "ode") return make_ode_world(scene);
   if (engine == "mujoco") return make_mujoco_world(scene);
   if (engine == "bullet") return make_bullet_world(scene);
+#endif
   throw std::invalid_argument("unknown engine " + engine);
 }
 
@@ -342,7 +361,7 @@ void write_csv_row(std::FILE* f, const Row& r) {
 // ---- options -------------------------------------------------------------------------------
 
 constexpr const char* kUsage =
-    "usage: graspsim_peers [--engines ode,mujoco,bullet] [--layouts apart,island,tower,pyramid,pile]\n"
+    "usage: graspsim_peers [--engines graspsim,ode,mujoco,bullet] [--layouts apart,island,tower,pyramid,pile]\n"
     "                      [--n 16,64,144,400,1000] [--rates 50,500,3000] [--gap M] [--duration S]\n"
     "                      [--repeats R] [--csv FILE] [--sleep] [--verbose]\n"
     "  --n: boxes asked for (a pyramid takes the largest triangular number below); --rates in Hz;\n"
@@ -382,8 +401,10 @@ Options parse(int argc, char** argv) {
     const std::string value = argv[++i];
     if (arg == "--engines") {
       o.engines = split(value);
+      const std::vector<std::string> known = available_engines();
       for (const std::string& e : o.engines)
-        if (e != "ode" && e != "mujoco" && e != "bullet") throw std::invalid_argument("unknown engine " + e);
+        if (std::find(known.begin(), known.end(), e) == known.end())
+          throw std::invalid_argument("unknown engine " + e + " (this build has: " + join(known) + ")");
     } else if (arg == "--layouts") {
       o.layouts.clear();
       for (const std::string& name : split(value)) {

@@ -1,6 +1,7 @@
-// graspsim_peers (tools/bench/README.md, "Peers"): what each peer engine provides, a World built
-// from the scale scenes' box poses (bench/scale_scenes.hpp), and the record measured for one
-// (engine, layout, n, rate) run. Engine types stay inside ode.cpp, mujoco.cpp and bullet.cpp.
+// graspsim_peers (tools/bench/README.md, "Peers"): what each engine (graspsim and its peers)
+// provides, a World built from the scale scenes' box poses (bench/scale_scenes.hpp), and the
+// record measured for one (engine, layout, n, rate) run. Engine types stay inside graspsim.cpp,
+// ode.cpp, mujoco.cpp and bullet.cpp.
 #pragma once
 
 #include <memory>
@@ -40,6 +41,7 @@ class World {
   virtual std::string notes() const { return {}; }           // settings chosen by the engine (--verbose)
 };
 
+std::unique_ptr<World> make_graspsim_world(const Scene& scene);
 std::unique_ptr<World> make_ode_world(const Scene& scene);
 std::unique_ptr<World> make_mujoco_world(const Scene& scene);
 std::unique_ptr<World> make_bullet_world(const Scene& scene);
