@@ -50,7 +50,7 @@ void TraceWriter::Impl::freeze() {
   {
     // Checked here, before the writer thread exists, so a table HDF5 cannot store fails at the
     // first row, not at close: a compound type is stored in one object header message, at most
-    // 64 KiB (about 90 objects of /physics with short names).
+    // 64 KiB (about 90 objects of /physics with short names), and a chunk holds less than 4 GiB.
     h5::Lock lock;
     h5::Quiet quiet;
     for (auto& [name, table] : tables) {
@@ -63,6 +63,11 @@ void TraceWriter::Impl::freeze() {
                          std::to_string(encoded) + "-byte HDF5 row type, more than the " +
                          std::to_string(kMaxRowTypeBytes) +
                          " an object header holds (fewer objects or fingers, or shorter names)");
+      }
+      if (t.packed_width > kMaxChunkBytes / t.block_rows) {
+        throw TraceError(where + ": a chunk of " + std::to_string(t.block_rows) + " rows of " +
+                         std::to_string(t.packed_width) + " bytes is more than HDF5's chunk limit of " +
+                         std::to_string(kMaxChunkBytes) + " bytes (4 GiB - 1)");
       }
     }
   }

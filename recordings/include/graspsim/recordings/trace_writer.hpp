@@ -46,6 +46,10 @@ constexpr const char* name_of(DType dtype) {
   return "?";
 }
 
+// The most bytes HDF5 stores in one chunk (2^32 - 1): a table's chunk, `block_rows` rows, must
+// fit in it, which bounds one row of a table to just under 4 GiB (recordings/README.md "Limits").
+inline constexpr std::size_t kMaxChunkBytes = 0xFFFFFFFFu;   // bytes
+
 // The row value of a kUInt64 column: the 64 bits of `value` carried in a double, unchanged
 // (written back bit for bit; never do arithmetic on it).
 inline double uint64_in_row(std::uint64_t value) { return std::bit_cast<double>(value); }
