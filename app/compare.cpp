@@ -115,7 +115,9 @@ std::string compare_table(const CompareResult& r, bool all) {
   o << "graspsim compare\n";
   o << "  A  " << r.file_a << "\n";
   o << "  B  " << r.file_b << "\n";
-  o << "  schema " << r.schema_version << ", rates " << r.rate_servo << " / " << r.rate_haptic
+  o << "  schema " << r.schema_version;
+  if (r.schema_version_b != r.schema_version) o << " (B: " << r.schema_version_b << ")";
+  o << ", rates " << r.rate_servo << " / " << r.rate_haptic
     << " / " << r.rate_physics << " Hz (servo / haptic / physics)\n";
   if (opt.bitwise) {
     o << "  test       bitwise: every element's stored bits equal (NaN equals NaN with the same "
@@ -226,6 +228,7 @@ std::string compare_json(const CompareResult& r) {
   o << "  \"same\": " << (r.same() ? "true" : "false") << ",\n";
   o << "  \"exit_code\": " << (r.same() ? 0 : 1) << ",\n";
   o << "  \"schema_version\": " << r.schema_version << ",\n";
+  o << "  \"schema_version_b\": " << r.schema_version_b << ",\n";
   o << "  \"rates\": {\"servo\": " << r.rate_servo << ", \"haptic\": " << r.rate_haptic
     << ", \"physics\": " << r.rate_physics << "},\n";
   o << "  \"bitwise\": " << (opt.bitwise ? "true" : "false") << ",\n";

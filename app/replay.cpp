@@ -44,9 +44,8 @@ std::string recorded_fingers(const std::string& trace) {
   return names.empty() ? "none" : names;
 }
 
-// An (n, 3) float64 dataset as n vectors.
-std::vector<hw::Vec3> read_vec3(const std::string& trace, const std::string& path) {
-  const recordings::Dataset d = recordings::read_dataset(trace, path);
+// An (n, 3) float64 column `path` as n vectors.
+std::vector<hw::Vec3> vec3_rows(const recordings::Dataset& d, const std::string& trace, const std::string& path) {
   if (d.shape.size() != 2 || d.shape[1] != 3 || d.dtype != recordings::DType::kFloat64) {
     throw ReplayError(trace + ": " + path + ": expected an (n, 3) float64 dataset");
   }
@@ -115,12 +114,17 @@ bool parse_mapping(const std::string& text, hw::WorkspaceMapping& m) {
 
 RecordedDeviceRows read_device_rows(const std::string& trace, const std::string& table) {
   RecordedDeviceRows r;
-  r.position = read_vec3(trace, table + "/position");
-  r.gimbal = read_vec3(trace, table + "/gimbal");
-  const recordings::Dataset buttons = recordings::read_dataset(trace, table + "/buttons");
-  const recordings::Dataset time = recordings::read_dataset(trace, table + "/device_time");
-  const recordings::Dataset overrun = recordings::read_dataset(trace, table + "/overrun");
-  const recordings::Dataset ticks = recordings::read_dataset(trace, table + "/tick");
+  // The device's sample numbering, where the trace has the columns (-1 where it predates them).
+  r.counted = recordings::has_object(trace, table + "/sequence") && recordings::has_object(trace, table + "/new_samples");
+  std::vector<std::string> names = {"position", "gimbal", "buttons", "device_time", "overrun", "tick"};
+  if (r.counted) names.insert(names.end(), {"sequence", "new_samples"});
+  const recordings::Table rows = recordings::read_table(trace, table, names);
+  r.position = vec3_rows(rows.column("position"), trace, table + "/position");
+  r.gimbal = vec3_rows(rows.column("gimbal"), trace, table + "/gimbal");
+  const recordings::Dataset& buttons = rows.column("buttons");
+  const recordings::Dataset& time = rows.column("device_time");
+  const recordings::Dataset& overrun = rows.column("overrun");
+  const recordings::Dataset& ticks = rows.column("tick");
   const std::size_t n = r.position.size();
   if (r.gimbal.size() != n || buttons.values.size() != n || time.values.size() != n || overrun.values.size() != n ||
       ticks.values.size() != n)
@@ -132,16 +136,12 @@ RecordedDeviceRows read_device_rows(const std::string& trace, const std::string&
     r.overrun.push_back(overrun.values[i] != 0.0);
   }
   r.device_time = time.values;
-  // The device's sample numbering (-1 where the trace predates the columns).
-  for (auto [column, out] : {std::pair{"/sequence", &r.sequence}, std::pair{"/new_samples", &r.new_samples}}) {
-    recordings::Dataset d;
-    try {
-      d = recordings::read_dataset(trace, table + column);
-    } catch (const recordings::TraceError&) {   // no such column: the table's others were read
+  for (auto [column, out] : {std::pair{"sequence", &r.sequence}, std::pair{"new_samples", &r.new_samples}}) {
+    if (!r.counted) {
       out->assign(n, -1);
-      r.counted = false;
       continue;
     }
+    const recordings::Dataset& d = rows.column(column);
     if (d.values.size() != n) throw ReplayError(trace + ": " + table + ": columns of different lengths");
     for (double v : d.values) out->push_back(static_cast<std::int64_t>(v));
   }
@@ -277,17 +277,26 @@ ReplayPlan load(const std::string& trace, const ReplayOptions& options) {
     }
   }
 
-  // The device inputs, one row per servo tick from 0.
-  const recordings::Dataset ticks = recordings::read_dataset(trace, "/servo/tick");
+  // The device inputs, one row per servo tick from 0: every finger's, in one pass over /servo.
+  const std::vector<std::string> columns = recordings::list_datasets(trace);
+  std::vector<std::string> inputs = {"tick"};
+  for (const FingerParams& finger : model.fingers) {
+    const std::string p = "fingers/" + finger.name + "/";
+    for (const char* column : {"hip", "gimbal"}) {
+      if (!std::binary_search(columns.begin(), columns.end(), "/servo/" + p + column))
+        throw ReplayError(trace + ": the scenario's finger '" + finger.name + "' has no recorded inputs (/servo/" + p +
+                          "hip and gimbal); fingers in the trace: " + recorded_fingers(trace));
+      inputs.push_back(p + column);
+    }
+  }
+  const recordings::Table servo = recordings::read_table(trace, "/servo", inputs);
+  const recordings::Dataset& ticks = servo.column("tick");
   std::int64_t rows = static_cast<std::int64_t>(ticks.values.size());
   for (std::size_t f = 0; f < model.fingers.size(); ++f) {
     const std::string& name = model.fingers[f].name;
-    const std::string p = "/servo/fingers/" + name + "/";
-    if (!recordings::has_object(trace, p + "hip") || !recordings::has_object(trace, p + "gimbal")) {
-      throw ReplayError(trace + ": the scenario's finger '" + name + "' has no recorded inputs (" + p +
-                        "hip and gimbal); fingers in the trace: " + recorded_fingers(trace));
-    }
-    RecordedFinger r{read_vec3(trace, p + "hip"), read_vec3(trace, p + "gimbal"), std::nullopt};
+    const std::string p = "fingers/" + name + "/";
+    RecordedFinger r{vec3_rows(servo.column(p + "hip"), trace, "/servo/" + p + "hip"),
+                     vec3_rows(servo.column(p + "gimbal"), trace, "/servo/" + p + "gimbal"), std::nullopt};
     rows = std::min({rows, static_cast<std::int64_t>(r.hip.size()), static_cast<std::int64_t>(r.gimbal.size())});
     if (recordings::has_object(trace, "/devices/" + name)) {
       r.device = read_device_rows(trace, "/devices/" + name);
@@ -339,20 +348,23 @@ RecordedFinger read_recorded_finger(const std::string& trace, const std::string&
     if (!recordings::has_attribute(trace, "/", "schema_version"))
       throw ReplayError(trace + ": not a graspsim trace (no root attribute 'schema_version')");
     const std::int64_t schema = recordings::read_int_attribute(trace, "/", "schema_version");
-    if (schema < 2 || schema > recordings::kSchemaVersion)
-      throw ReplayError(trace + ": schema_version " + std::to_string(schema) + " cannot be replayed (this graspsim reads 2 to " +
+    if (schema < recordings::kOldestSchemaVersion || schema > recordings::kSchemaVersion)
+      throw ReplayError(trace + ": schema_version " + std::to_string(schema) + " cannot be replayed (this graspsim reads " +
+                        std::to_string(recordings::kOldestSchemaVersion) + " to " +
                         std::to_string(recordings::kSchemaVersion) + ")");
     replayable_selection(trace, "a finger replayed from it (--device FINGER=replay:TRACE)");
     const std::int64_t recorded_rate = recordings::read_int_attribute(trace, "/", "rate_servo");
     if (recorded_rate != rate_servo)
       throw ReplayError(trace + ": recorded at rate_servo = " + std::to_string(recorded_rate) + " Hz, but this run's servo rate is " +
                         std::to_string(rate_servo) + " Hz: the samples are one per recorded servo tick");
-    const std::string p = "/servo/fingers/" + finger + "/";
-    if (!recordings::has_object(trace, p + "hip") || !recordings::has_object(trace, p + "gimbal"))
-      throw ReplayError(trace + ": no recorded inputs of finger '" + finger + "' (" + p + "hip and gimbal); fingers in the trace: " +
-                        recorded_fingers(trace));
-    RecordedFinger r{read_vec3(trace, p + "hip"), read_vec3(trace, p + "gimbal"), std::nullopt};
-    const recordings::Dataset ticks = recordings::read_dataset(trace, "/servo/tick");
+    const std::string p = "fingers/" + finger + "/";
+    if (!recordings::has_object(trace, "/servo/" + p + "hip") || !recordings::has_object(trace, "/servo/" + p + "gimbal"))
+      throw ReplayError(trace + ": no recorded inputs of finger '" + finger + "' (/servo/" + p +
+                        "hip and gimbal); fingers in the trace: " + recorded_fingers(trace));
+    const recordings::Table servo = recordings::read_table(trace, "/servo", {"tick", p + "hip", p + "gimbal"});
+    RecordedFinger r{vec3_rows(servo.column(p + "hip"), trace, "/servo/" + p + "hip"),
+                     vec3_rows(servo.column(p + "gimbal"), trace, "/servo/" + p + "gimbal"), std::nullopt};
+    const recordings::Dataset& ticks = servo.column("tick");
     const std::size_t rows = std::min({ticks.values.size(), r.hip.size(), r.gimbal.size()});
     for (std::size_t n = 0; n < rows; ++n) {
       if (ticks.values[n] != static_cast<double>(n))

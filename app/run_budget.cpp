@@ -101,6 +101,16 @@ MachineRoom machine_room(const std::string& out_path) {
 }
 
 std::string refusal(const RunFootprint& need, const MachineRoom& room, int compression, std::string* warning) {
+  // A table's chunk (its block: one flush interval of rows) must fit in one HDF5 chunk, whatever
+  // the machine (recordings/README.md "Limits"): refused here, before the run, not at its first row.
+  for (const TableFootprint& t : need.tables) {
+    if (t.block_rows * static_cast<double>(t.bytes) > static_cast<double>(recordings::kMaxChunkBytes)) {
+      return "the trace's " + t.name + " table would need chunks of " + bytes_text(t.block_rows * static_cast<double>(t.bytes)) +
+             " (" + std::to_string(static_cast<long long>(t.block_rows)) + " rows of " + bytes_text(static_cast<double>(t.bytes)) +
+             "), more than HDF5's limit of 4.3 GB (2^32 - 1 bytes) a chunk: run fewer fingers and objects, lower the rates, "
+             "or run without a trace (--no-trace)";
+    }
+  }
   if (room.memory_available >= 0.0 && need.memory > room.memory_available) {
     return "the run's trace buffers need " + bytes_text(need.memory) + " of memory (" + need.memory_detail +
            "), and this machine has " + bytes_text(room.memory_available) +

@@ -44,7 +44,9 @@ struct MachineRoom {
 };
 MachineRoom machine_room(const std::string& out_path);
 
-// "" when the run fits; otherwise why not, with both figures. A compressed trace (compression >
+// "" when the run fits; otherwise why not, with both figures. A table whose chunk (its block,
+// one flush interval of rows) would pass HDF5's chunk limit (recordings::kMaxChunkBytes, 4 GiB) is
+// refused on any machine. A compressed trace (compression >
 // 0) is not refused for disk: its size is not known before (deflate gives 5 to 10x on traces,
 // recordings/README.md); `warning` then says how much it would need uncompressed.
 std::string refusal(const RunFootprint& need, const MachineRoom& room, int compression, std::string* warning);

@@ -31,7 +31,7 @@ import os
 import sys
 import tempfile
 
-SUPPORTED_SCHEMA = (1, 2, 3)
+SUPPORTED_SCHEMA = (1, 2, 3, 4)
 STATE_NAMES = {0: "free", 1: "stick", 2: "slip"}
 STATE_COLOURS = {0: "#e4e4e4", 1: "#4daf4a", 2: "#e41a1c"}
 
@@ -52,6 +52,7 @@ class Trace:
     def __init__(self, path, np, h5py):
         self.path = path
         self.h5py = h5py
+        self.tables = {}   # table dataset name -> {column: array} (table_columns)
         self.label = os.path.basename(path)
         if not os.path.exists(path):
             raise BadInput(f"{path}: no such file")
@@ -76,36 +77,59 @@ class Trace:
         with f:
             self._read(f, np)
 
+    def table_columns(self, table):
+        """{column: array} of a table dataset, its rows read once. A member is a column (schema 3:
+        "objects/b/position"); a member that is an array of compound elements (schema 4) is a
+        group of entities named by the table's attribute of the member's name, one a line: field
+        f of entity e is column "<member>/<e>/<f>"."""
+        if table.name not in self.tables:
+            rows = table[()]
+            columns = {}
+            for member in rows.dtype.names:
+                sub = rows.dtype[member].subdtype
+                if sub is None or sub[0].names is None:
+                    columns[member] = rows[member]
+                    continue
+                entities = [e for e in text(table.attrs.get(member, "")).split("\n") if e]
+                if len(entities) != sub[1][0]:
+                    raise BadInput(f"{self.path}: {table.name}: member {member} holds {sub[1][0]} "
+                                   f"entities but its attribute names {len(entities)}")
+                for k, entity in enumerate(entities):
+                    for field in sub[0].names:
+                        columns[f"{member}/{entity}/{field}"] = rows[member][:, k][field]
+            self.tables[table.name] = columns
+        return self.tables[table.name]
+
     def split(self, f, name):
-        """(table dataset, member) for a column of a schema 3 table ("/physics/objects/b/position"
-        is member "objects/b/position" of compound dataset "/physics"), else (None, None)."""
+        """(columns of its table, column) for a column of a schema 3 or 4 table
+        ("/physics/objects/b/position" is column "objects/b/position" of compound dataset
+        "/physics"), else (None, None)."""
         table, _, member = name.lstrip("/").partition("/")
         obj = f.get(table)
         if isinstance(obj, self.h5py.Dataset) and obj.dtype.names is not None:
-            return obj, member
+            return self.table_columns(obj), member
         return None, None
 
     def has(self, f, name):
-        table, member = self.split(f, name)
-        if table is not None:
-            return member in table.dtype.names
+        columns, member = self.split(f, name)
+        if columns is not None:
+            return member in columns
         return name in f
 
     def names_below(self, f, name):
-        """Next path components below `name`: member-name prefixes (schema 3) or group keys."""
-        table, member = self.split(f, name)
-        if table is not None:
+        """Next path components below `name`: column-name prefixes (schema 3, 4) or group keys."""
+        columns, member = self.split(f, name)
+        if columns is not None:
             prefix = member + "/"
-            return sorted({m[len(prefix):].split("/")[0] for m in table.dtype.names
-                           if m.startswith(prefix)})
+            return sorted({m[len(prefix):].split("/")[0] for m in columns if m.startswith(prefix)})
         return sorted(f[name].keys()) if name in f else []
 
     def need(self, f, name):
         if not self.has(f, name):
             raise BadInput(f"{self.path}: not a complete graspsim trace: missing dataset {name}")
         try:
-            table, member = self.split(f, name)
-            return table[member] if table is not None else f[name][()]
+            columns, member = self.split(f, name)
+            return columns[member] if columns is not None else f[name][()]
         except (OSError, TypeError, ValueError) as e:
             raise BadInput(f"{self.path}: cannot read dataset {name} ({e})")
 

@@ -398,8 +398,9 @@ PYBIND11_MODULE(graspsim, m) {
       [](const py::object& file) {
         const std::string path = fspath(file);
         py::dict d;
-        for (const std::string& name : graspsim::recordings::list_datasets(path))
-          d[py::str(name)] = dataset_array(graspsim::recordings::read_dataset(path, name));
+        // Each table read once, whatever its layout (a 1000-object /physics is one pass).
+        for (const auto& [name, dataset] : graspsim::recordings::read_trace(path))
+          d[py::str(name)] = dataset_array(dataset);
         return d;
       },
       py::arg("path"), "Every dataset of a trace, {\"/physics/objects/box/position\": array, ...}, in its stored type");

@@ -18,14 +18,15 @@ namespace graspsim::recordings::compare {
 
 enum class Kind { kFloat, kSigned, kUnsigned };
 
-// The rows of one compound table of one file, a block at a time, in the file's row layout
-// converted to native types (no conversion on a little-endian host). All columns of the table
-// decode their members from the same block, so a table is read once however many columns it
-// has; row(r) may move back and forth within a block, forward across blocks.
+// The rows of one compound table of one file, a block at a time, in the file's row layout with
+// native numbers (h5::packed_native: no conversion of a trace written on a little-endian host).
+// All columns of the table decode their members from the same block, so a table is read once
+// however many columns it has; row(r) may move back and forth within a block, forward across
+// blocks.
 struct TableRows {
   std::string file, path;          // for messages
-  hid_t dataset = H5I_INVALID_HID; // not owned (the columns' handles keep it open)
-  h5::Handle type;                 // native row type
+  h5::Handle dataset;              // the table
+  h5::Handle type;                 // the row type read: h5::packed_native of the table's
   std::size_t row_bytes = 0;
   std::int64_t rows = 0;           // rows to read (the usable length)
   std::int64_t block = 1;
@@ -43,9 +44,9 @@ struct TableRows {
 // One open dataset of an aligned table: its kind, rows and width.
 struct Column {
   std::string file, path;   // path with a leading '/'
-  h5::Handle dataset;       // the column's dataset, or its table's (member not empty)
-  std::string member;       // the column's member of a compound table, or "" 
-  // A member: where its elements sit in a row of the table's native row type, and how to
+  h5::Handle dataset;       // the column's dataset (schema 2; not opened for a table's column)
+  std::string member;       // the column of a compound table (table_layout.hpp), or "" 
+  // A member: where its elements sit in a row as TableRows reads it, and how to
   // decode them (class, size in bytes, signed), read from the rows the table shares.
   TableRows* table_rows = nullptr;
   std::size_t member_offset = 0;
@@ -60,9 +61,10 @@ struct Column {
   std::vector<std::string> order;   // the "order" attribute split at commas, if any
 };
 
-// Opens column `name` of table `group` (its path is "/" + group + "/" + name): its kind,
-// rows, width, units and components (the `order` attribute).
-Column open_column(const OpenTrace& t, const std::string& group, const std::string& name);
+// Opens columns `names` of table `group` (a column's path is "/" + group + "/" + name): their
+// kind, rows, width, units and components (the `order` attribute). A compound table's layout is
+// read once for all of them (table_layout.hpp), each distinct attribute once.
+std::vector<Column> open_columns(const OpenTrace& t, const std::string& group, const std::vector<std::string>& names);
 
 // The native HDF5 type a column is read as: float64, int64 or uint64.
 template <typename T>

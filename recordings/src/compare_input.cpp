@@ -5,6 +5,7 @@
 #include <cstdio>
 
 #include "h5_checks.hpp"
+#include "table_layout.hpp"
 
 namespace graspsim::recordings::compare {
 namespace {
@@ -28,7 +29,7 @@ std::string format_double(double x) {
 bool is_table_dataset(hid_t loc, const std::string& path, const std::string& context) {
   h5::Handle d = h5::checked(H5Dopen2(loc, path.c_str(), H5P_DEFAULT), H5Dclose,
                              context + ": cannot open " + quoted(path));
-  return !h5::member_names(d.get(), context).empty();
+  return h5::is_table(d.get(), context);
 }
 
 }  // namespace
@@ -98,8 +99,8 @@ H5I_type_t object_type(hid_t loc, const std::string& path, const std::string& co
   return H5Iget_type(object.get());
 }
 
-// Tables at the top of the file, by name: compound datasets (schema 3: one dataset per loop,
-// one member per column) or groups of datasets (schema 2 and before).
+// Tables at the top of the file, by name: compound datasets (schema 3 and 4: one dataset per loop,
+// its columns in its rows) or groups of datasets (schema 2 and before).
 std::vector<std::string> top_groups(const OpenTrace& t) {
   const std::string context = "trace " + quoted(t.name);
   std::vector<std::string> links, groups;
@@ -127,7 +128,7 @@ std::vector<std::string> top_groups(const OpenTrace& t) {
   return groups;
 }
 
-// Every column of table `group`, by name: the members of a compound table, or the datasets
+// Every column of table `group`, by name: the columns of a compound table (table_layout.hpp), or the datasets
 // below a group (recursively), as paths relative to it.
 std::vector<std::string> datasets_below(const OpenTrace& t, const std::string& group) {
   const std::string context = "trace " + quoted(t.name);
@@ -135,9 +136,7 @@ std::vector<std::string> datasets_below(const OpenTrace& t, const std::string& g
   if (object_type(t.file.get(), group, context) == H5I_DATASET) {
     h5::Handle d = h5::checked(H5Dopen2(t.file.get(), group.c_str(), H5P_DEFAULT), H5Dclose,
                                context + ": cannot open " + quoted("/" + group));
-    out = h5::member_names(d.get(), context);
-    std::sort(out.begin(), out.end());
-    return out;
+    return h5::table_layout(d.get(), context + ", table " + quoted("/" + group)).sorted_names();
   }
   h5::Handle g = h5::checked(H5Gopen2(t.file.get(), group.c_str(), H5P_DEFAULT), H5Gclose,
                              context + ": cannot open group " + quoted("/" + group));

@@ -34,11 +34,11 @@ std::int64_t int_attribute(const OpenTrace& t, const std::string& name);
 
 // Whether `path` below `loc` is a dataset, a group, ...
 H5I_type_t object_type(hid_t loc, const std::string& path, const std::string& context);
-// Tables at the top of the file, by name: compound datasets (schema 3: one dataset per loop,
-// one member per column), the tables of a group of tables (/devices/<finger>), or groups of
+// Tables at the top of the file, by name: compound datasets (schema 3 and 4: one dataset per loop,
+// its columns in its rows), the tables of a group of tables (/devices/<finger>), or groups of
 // datasets (schema 2 and before).
 std::vector<std::string> top_groups(const OpenTrace& t);
-// Every column of table `group`, sorted: the members of a compound table, or the datasets
+// Every column of table `group`, sorted: the columns of a compound table (table_layout.hpp), or the datasets
 // below a group (recursively), as paths relative to it.
 std::vector<std::string> datasets_below(const OpenTrace& t, const std::string& group);
 

@@ -10,6 +10,7 @@
 #include <variant>
 
 #include "compare_columns.hpp"
+#include "table_layout.hpp"
 
 namespace graspsim::recordings::compare {
 namespace {
@@ -173,10 +174,8 @@ LoopColumns open_loop(const OpenTrace& a, const OpenTrace& b, const std::string&
     if (!std::binary_search(cols.names.begin(), cols.names.end(), key))
       fail("table " + quoted("/" + group) + " of " + quoted(a.name) + " and " + quoted(b.name) +
            " has no " + quoted(key) + " column, so its rows cannot be aligned");
-  for (const std::string& n : cols.names) {
-    cols.a.push_back(open_column(a, group, n));
-    cols.b.push_back(open_column(b, group, n));
-  }
+  cols.a = open_columns(a, group, cols.names);
+  cols.b = open_columns(b, group, cols.names);
   cols.rows_a = usable_rows(cols.a, a, group, result);
   cols.rows_b = usable_rows(cols.b, b, group, result);
   const auto index_of = [&](const char* key) {
@@ -211,10 +210,10 @@ void share_table_rows(SharedRows& shared, LoopColumns& cols, const OpenTrace& a,
     t.emplace();
     t->file = o.name;
     t->path = "/" + group;
-    t->dataset = columns[cols.tick].dataset.get();
     const std::string context = "trace " + quoted(o.name) + ", table " + quoted("/" + group);
-    h5::Handle file_type = h5::checked(H5Dget_type(t->dataset), H5Tclose, context);
-    t->type = h5::checked(H5Tget_native_type(file_type.get(), H5T_DIR_ASCEND), H5Tclose, context);
+    t->dataset = h5::checked(H5Dopen2(o.file.get(), group.c_str(), H5P_DEFAULT), H5Dclose, context + ": cannot open");
+    h5::Handle file_type = h5::checked(H5Dget_type(t->dataset.get()), H5Tclose, context);
+    t->type = h5::packed_native(file_type.get(), context);   // the offsets table_layout gives the columns
     t->row_bytes = H5Tget_size(t->type.get());
     t->rows = rows;
     t->block = std::max<std::int64_t>(

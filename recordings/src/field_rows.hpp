@@ -7,6 +7,7 @@
 #include <iterator>
 #include <string>
 #include <utility>
+#include <vector>
 
 #include "graspsim/recordings/trace_recorder.hpp"
 #include "graspsim/recordings/trace_schema.hpp"
@@ -26,6 +27,21 @@ std::size_t declare(TraceTable& table, const std::string& prefix, const Field<Re
     if (k == 0) first = offset;
     if (!f.note.name.empty()) table.set_attribute(path, std::string(f.note.name), std::string(f.note.value));
   }
+  return first;
+}
+
+// Declares `fields` for every one of `entities` as group `group` of `table` (TraceTable::add_group),
+// with their units and notes (one per field, shared by the entities); returns the offset of the
+// first entity's first field. Entity k's fields start `size_of_fields(fields).values` * k after it.
+template <typename Record, std::size_t N>
+std::size_t declare_group(TraceTable& table, const std::string& group, const std::vector<std::string>& entities,
+                          const Field<Record> (&fields)[N]) {
+  std::vector<TraceTable::Field> spec;
+  for (const Field<Record>& f : fields) spec.push_back({std::string(f.name), f.width, f.dtype, std::string(f.units)});
+  const std::size_t first = table.add_group(group, entities, spec);
+  for (const Field<Record>& f : fields)
+    if (!f.note.name.empty())
+      table.set_attribute(group + "/" + std::string(f.name), std::string(f.note.name), std::string(f.note.value));
   return first;
 }
 

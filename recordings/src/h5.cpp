@@ -157,45 +157,6 @@ void write_scalar_attribute(hid_t object, const std::string& name, hid_t file_ty
   check(H5Awrite(attribute.get(), memory_type, value), where);
 }
 
-Member member_of(hid_t dataset, const std::string& name, const std::string& context) {
-  Handle row = checked(H5Dget_type(dataset), H5Tclose, context);
-  const int index = H5Tget_member_index(row.get(), name.c_str());
-  if (index < 0) throw TraceError(context + ": no member '" + name + "'");
-  const auto k = static_cast<unsigned>(index);
-  Member out;
-  Handle type = checked(H5Tget_member_type(row.get(), k), H5Tclose, context);
-  if (H5Tget_class(type.get()) == H5T_ARRAY) {
-    if (H5Tget_array_ndims(type.get()) != 1) throw TraceError(context + ": not a 1-D array member");
-    hsize_t dims[1] = {0};
-    check(H5Tget_array_dims2(type.get(), dims), context);
-    out.element = checked(H5Tget_super(type.get()), H5Tclose, context);
-    // A damaged type may claim any width: it must be sane and agree with the member's bytes.
-    const std::size_t element = H5Tget_size(out.element.get());
-    if (dims[0] < 1 || dims[0] > kMaxColumnWidth || element == 0 || dims[0] * element != H5Tget_size(type.get()))
-      throw TraceError(context + ": member '" + name + "' is an array of " + std::to_string(dims[0]) +
-                       " elements that does not fit its " + std::to_string(H5Tget_size(type.get())) + " bytes (damaged?)");
-    out.width = static_cast<std::size_t>(dims[0]);
-  } else {
-    out.element = std::move(type);
-  }
-  Handle native = checked(H5Tget_native_type(row.get(), H5T_DIR_ASCEND), H5Tclose, context);
-  out.native_offset = H5Tget_member_offset(native.get(), k);
-  return out;
-}
-
-std::vector<std::string> member_names(hid_t dataset, const std::string& context) {
-  Handle type = checked(H5Dget_type(dataset), H5Tclose, context);
-  std::vector<std::string> names;
-  if (H5Tget_class(type.get()) != H5T_COMPOUND) return names;
-  const int n = H5Tget_nmembers(type.get());
-  for (int k = 0; k < n; ++k) {
-    char* name = H5Tget_member_name(type.get(), static_cast<unsigned>(k));
-    if (name != nullptr) names.emplace_back(name);
-    H5free_memory(name);
-  }
-  return names;
-}
-
 bool has_attribute(hid_t object, const std::string& name, const std::string& context) {
   const htri_t exists = H5Aexists(object, name.c_str());
   check(exists, context + ": cannot look for attribute '" + name + "'");

@@ -90,18 +90,6 @@ void write_scalar_attribute(hid_t object, const std::string& name, hid_t file_ty
                             hid_t memory_type, const void* value, const std::string& context);
 
 bool has_attribute(hid_t object, const std::string& name, const std::string& context);
-// Column `name` of a compound table (schema 3): its element type (the array's base for a
-// width > 1 column), its width, and its byte offset in the table's native row type. Throws
-// TraceError(context + ...) for no such member or an array that is not 1-D.
-struct Member {
-  Handle element;             // element type (file type)
-  std::size_t width = 1;      // values per row
-  std::size_t native_offset = 0;   // bytes into a row of H5Tget_native_type(row type)
-};
-Member member_of(hid_t dataset, const std::string& name, const std::string& context);
-// The member names of a compound dataset's element type (a schema 3 table), in order; empty for
-// any other dataset.
-std::vector<std::string> member_names(hid_t dataset, const std::string& context);
 // Variable- or fixed-length string attribute with one element.
 std::string read_string_attribute(hid_t object, const std::string& name,
                                   const std::string& context);

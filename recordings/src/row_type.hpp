@@ -13,11 +13,25 @@
 namespace graspsim::recordings::writer {
 
 struct Column {
-  std::string name;      // member name, relative to the table: "fingers/thumb/hip"
+  std::string name;      // column path, relative to the table: "tick", "fingers/thumb/hip"
   int width;             // values per row
   DType dtype;
   std::size_t offset;    // doubles into a row of the block buffer
   std::size_t bytes;     // bytes into a packed compound row
+  int group = -1;        // the entity group it is a field of (index into the groups), or -1:
+                         //   a member of its own
+};
+
+// Columns repeated per entity (a body, a finger), stored as one member of the row: an array of
+// one compound element per entity, a member per field (recordings/README.md "Schema"). Its
+// columns are also listed one per entity and field (Column::group), contiguous, entity by entity,
+// so that rows are packed as any other columns are.
+struct Group {
+  std::string name;                     // member name: "objects"
+  std::vector<std::string> entities;    // in row order
+  std::vector<Column> fields;           // field name, width, dtype; offset and bytes within an entity
+  std::size_t first = 0;                // index of its first column (entity 0, field 0)
+  std::size_t entity_bytes = 0;         // bytes of one entity's packed fields
 };
 
 hid_t file_type_of(DType dtype);     // little-endian, as stored
@@ -54,14 +68,16 @@ inline bool fits(double value, DType dtype) {
   return dtype == DType::kInt64 ? value < highest(dtype) : value <= highest(dtype);
 }
 
-// The compound type of a row: one member per column in declaration order, packed into `bytes`;
-// array members for width > 1. `memory`: native types, else the file's.
-h5::Handle row_type(const std::vector<Column>& columns, std::size_t bytes, bool memory,
-                    const std::string& where);
+// The compound type of a row: one member per column of no group in declaration order, array
+// members for width > 1, and one member per group, where its first column is, an array of one
+// compound element per entity; packed into `bytes`. `memory`: native types, else the file's.
+h5::Handle row_type(const std::vector<Column>& columns, const std::vector<Group>& groups, std::size_t bytes,
+                    bool memory, const std::string& where);
 
-// The size of the datatype message of a row of `columns` in the newest file format, which HDF5
-// stores in one object header message of at most 64 KiB (kMaxRowTypeBytes).
-std::size_t encoded_row_type_bytes(const std::vector<Column>& columns);
+// The size of the datatype message of that row type in the newest file format, which HDF5 stores
+// in one object header message of at most 64 KiB (kMaxRowTypeBytes). A group counts once,
+// whatever its number of entities.
+std::size_t encoded_row_type_bytes(const std::vector<Column>& columns, const std::vector<Group>& groups);
 
 // The largest compound row type a table may have: 64 KiB (65535 bytes), kept clear of by 1.5 KB.
 inline constexpr std::size_t kMaxRowTypeBytes = 64000;   // bytes

@@ -13,8 +13,8 @@ using namespace writer;
 void TraceTable::Impl::create_dataset(hid_t file_id) {
   const std::string where = context() + ": cannot create table " + quoted("/" + name);
   if (columns.empty()) throw TraceError(where + ": it has no columns");
-  h5::Handle file_type = row_type(columns, packed_width, false, where);
-  memory_type = row_type(columns, packed_width, true, where);
+  h5::Handle file_type = row_type(columns, groups, packed_width, false, where);
+  memory_type = row_type(columns, groups, packed_width, true, where);
   // A whole chunk is written straight to the file, past the chunk cache (a copy and its
   // bookkeeping saved), when the packed rows are the file's bytes: no filter, no conversion.
   const htri_t same = H5Tequal(file_type.get(), memory_type.get());

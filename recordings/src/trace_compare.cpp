@@ -13,6 +13,7 @@
 #include <set>
 
 #include "compare_input.hpp"
+#include "graspsim/recordings/trace_recorder.hpp"
 #include "compare_loop.hpp"
 
 namespace graspsim::recordings {
@@ -30,7 +31,9 @@ void check_options(const CompareOptions& options) {
       fail("tolerance rule " + quoted(r.pattern) + ": needs a pattern and tolerances >= 0");
 }
 
-// Both files are graspsim traces of one schema version; it goes to the result.
+// Both files are graspsim traces of one schema version, or of two that this graspsim reads
+// (kOldestSchemaVersion to kSchemaVersion: the same columns in other layouts, which the readers
+// see alike, so a schema 3 golden compares with a schema 4 run); they go to the result.
 void check_schema(const OpenTrace& a, const OpenTrace& b, const Attributes& attrs_a,
                   const Attributes& attrs_b, CompareResult& result) {
   for (const auto* t : {&a, &b}) {
@@ -40,11 +43,16 @@ void check_schema(const OpenTrace& a, const OpenTrace& b, const Attributes& attr
            " is not a graspsim trace (it has no root attribute 'schema_version')");
   }
   result.schema_version = int_attribute(a, "schema_version");
-  const std::int64_t version_b = int_attribute(b, "schema_version");
-  if (result.schema_version != version_b)
+  result.schema_version_b = int_attribute(b, "schema_version");
+  if (result.schema_version == result.schema_version_b) return;
+  const auto readable = [](std::int64_t v) { return v >= kOldestSchemaVersion && v <= kSchemaVersion; };
+  if (!readable(result.schema_version) || !readable(result.schema_version_b))
     fail("the traces have different schema versions: " + quoted(a.name) + " has " +
          std::to_string(result.schema_version) + ", " + quoted(b.name) + " has " +
-         std::to_string(version_b));
+         std::to_string(result.schema_version_b));
+  result.notes.push_back(quoted(a.name) + " is schema " + std::to_string(result.schema_version) + ", " +
+                         quoted(b.name) + " schema " + std::to_string(result.schema_version_b) +
+                         ": the same columns in another layout, compared column by column");
 }
 
 // Both files have the same servo, haptic and physics rates (a tick means the same time in

@@ -12,6 +12,7 @@
 #include "graspsim/recordings/trace_writer.hpp"
 #include "h5.hpp"
 #include "h5_checks.hpp"
+#include "table_layout.hpp"
 
 namespace graspsim::recordings {
 namespace {
@@ -94,7 +95,7 @@ std::vector<std::int64_t> read_tick_dataset(hid_t group, const std::string& wher
   return ticks;
 }
 
-// The `tick` member of a compound table (schema 3); false if it has none.
+// The `tick` member of a compound table (schema 3 and 4); false if it has none.
 bool read_tick_member(hid_t dataset, const std::string& where, std::vector<std::int64_t>& ticks) {
   const std::string context = "cannot read " + where;
   Handle type = checked(H5Dget_type(dataset), H5Tclose, context);
@@ -121,7 +122,7 @@ struct Copier {
     const std::string context = "cannot copy " + where;
     Handle in = checked(H5Dopen2(from, name.c_str(), H5P_DEFAULT), H5Dclose, context);
     Handle file_type = checked(H5Dget_type(in.get()), H5Tclose, context);
-    Handle memory_type = checked(H5Tget_native_type(file_type.get(), H5T_DIR_ASCEND), H5Tclose, context);
+    Handle memory_type = h5::packed_native(file_type.get(), context);   // no conversion of a trace's rows
     Handle in_space = checked(H5Dget_space(in.get()), H5Sclose, context);
     const int rank = H5Sget_simple_extent_ndims(in_space.get());
     if (rank < 1 || rank > 2) throw TraceError(context + ": rank " + std::to_string(rank));
@@ -148,7 +149,9 @@ struct Copier {
     Handle out_space = checked(H5Screate_simple(rank, out_dims, nullptr), H5Sclose, context);
     Handle dcpl = untimed(H5P_DATASET_CREATE, context);
     if (out_dims[0] > 0) {
-      hsize_t chunk[2] = {std::min<hsize_t>(out_dims[0], 8192), out_dims[1]};
+      // At most 8192 rows and 4 MiB a chunk (a wide table's rows: 1000 objects are 184 kB a row).
+      const hsize_t rows_per_chunk = std::max<hsize_t>(1, std::min<hsize_t>(8192, (4u << 20) / std::max<std::size_t>(row_bytes, 1)));
+      hsize_t chunk[2] = {std::min<hsize_t>(out_dims[0], rows_per_chunk), out_dims[1]};
       check(H5Pset_chunk(dcpl.get(), rank, chunk), context);
       check(H5Pset_shuffle(dcpl.get()), context);
       check(H5Pset_deflate(dcpl.get(), static_cast<unsigned>(compression)), context);
@@ -183,7 +186,7 @@ struct Copier {
   }
 
   // Copies top-level object `name`: a loop keeps its rows at ticks that are multiples of
-  // `stride` (schema 3 table or schema 2 group), anything else is copied whole.
+  // `stride` (schema 3 or 4 table, or schema 2 group), anything else is copied whole.
   void top_level(hid_t src, hid_t dst, const std::string& name, std::int64_t stride) const {
     const std::string where = "trace '" + file + "'";
     const std::string path = "/" + name;

@@ -2,9 +2,12 @@
 #include "graspsim/recordings/trace_reader.hpp"
 
 #include <algorithm>
+#include <cstring>
+#include <map>
 
 #include "h5.hpp"
 #include "h5_checks.hpp"
+#include "table_layout.hpp"
 
 namespace graspsim::recordings {
 namespace {
@@ -31,17 +34,20 @@ DType dtype_of(hid_t type, const std::string& context) {
 }
 
 
-// Where a logical path lives: a whole dataset (member empty), or member `member` of the table
-// dataset `table` (schema 3: "/physics/objects/box/position" is member "objects/box/position"
-// of dataset "/physics"), or an intermediate name of members ("/physics/objects": a "group").
+// Where a logical path lives: a whole dataset (member empty), or column `member` of the table
+// dataset `table` ("/physics/objects/box/position" is column "objects/box/position" of dataset
+// "/physics", a member of its rows in schema 3, a field of entity "box" of member "objects" in
+// schema 4: table_layout.hpp), or an intermediate name of columns ("/physics/objects": a "group").
 struct Location {
   h5::Handle object;         // the dataset or group at the path, or the table dataset
-  std::string member;        // member name, or member prefix for a group of members
-  bool member_prefix = false;   // `member` names a group of members, not one
+  std::string member;        // column name, or column prefix for a group of columns
+  bool member_prefix = false;   // `member` names a group of columns, not one
+  bool own_member = false;   // `member` is a member of its own, not a field of a group's entity
+  std::string attributes;    // a column's: the prefix of its attributes' names on the table
 };
 
-// Resolves `path` one link at a time; the first dataset on the way that is compound holds the
-// rest of the path as a member (or a prefix of members). nullopt-like: object invalid.
+// Resolves `path` one link at a time; the first dataset on the way that is a table holds the
+// rest of the path as a column (or a prefix of columns). nullopt-like: object invalid.
 Location locate(hid_t file, const std::string& path, const std::string& context) {
   Location out;
   std::size_t start = path.find_first_not_of('/');
@@ -65,21 +71,30 @@ Location locate(hid_t file, const std::string& path, const std::string& context)
     h5::Handle object = h5::checked(H5Oopen(file, prefix.c_str(), H5P_DEFAULT), H5Oclose,
                                     context + ": cannot open " + quoted(prefix));
     if (next != std::string::npos && H5Iget_type(object.get()) == H5I_DATASET) {
-      // The rest names a member of this table, or a prefix of member names.
+      // The rest names a column of this table, or a prefix of column names.
       std::string rest = path.substr(next);
       while (!rest.empty() && rest.back() == '/') rest.pop_back();
-      // An exact member wins; otherwise a prefix of members is a "group" of them.
-      bool exact = false, below = false;
-      for (const std::string& m : h5::member_names(object.get(), context)) {
-        exact = exact || m == rest;
-        below = below || m.rfind(rest + "/", 0) == 0;
+      if (!h5::is_table(object.get(), context)) return out;
+      // A member of its own ("tick") is found without reading any group's names.
+      if (h5::table_layout(object.get(), context + ", table " + quoted(prefix), false).find(rest) >= 0) {
+        out.object = std::move(object);
+        out.member = out.attributes = rest;
+        out.own_member = true;
+        return out;
       }
-      if (exact || below) {
+      const h5::TableLayout layout = h5::table_layout(object.get(), context + ", table " + quoted(prefix));
+      // An exact column wins; otherwise a prefix of columns is a "group" of them.
+      const std::ptrdiff_t exact = layout.find(rest);
+      const bool below = std::any_of(layout.columns.begin(), layout.columns.end(), [&](const h5::StoredColumn& c) {
+        return c.name.rfind(rest + "/", 0) == 0;
+      });
+      if (exact >= 0 || below) {
         out.object = std::move(object);
         out.member = rest;
-        out.member_prefix = !exact;
+        out.member_prefix = exact < 0;
+        out.attributes = exact >= 0 ? layout.columns[static_cast<std::size_t>(exact)].attributes : rest;
       }
-      return out;   // a prefix of members, or nothing (object invalid)
+      return out;   // a prefix of columns, or nothing (object invalid)
     }
     if (next == std::string::npos) {
       out.object = std::move(object);
@@ -94,22 +109,114 @@ Location locate(hid_t file, const std::string& path, const std::string& context)
 
 namespace {
 
-// Reads one member of a compound table into `out` (memory type `element`, width values a row):
-// a memory compound type with only that member makes HDF5 pick it out of every row.
-void read_member(hid_t dataset, const std::string& member, hid_t element, std::size_t width,
-                 void* out, const std::string& context) {
-  const std::size_t element_size = H5Tget_size(element);
-  h5::Handle field;
-  if (width > 1) {
-    const hsize_t dims[1] = {static_cast<hsize_t>(width)};
-    field = h5::checked(H5Tarray_create2(element, 1, dims), H5Tclose, context);
-  } else {
-    field = h5::checked(H5Tcopy(element), H5Tclose, context);
+// The DType of a table's column, or a TraceError naming it.
+DType dtype_of(const h5::StoredColumn& c, const std::string& context) {
+  if (c.element_class == H5T_FLOAT && c.element_size == 8) return DType::kFloat64;
+  if (c.element_class == H5T_INTEGER && c.element_signed) {
+    if (c.element_size == 8) return DType::kInt64;
+    if (c.element_size == 4) return DType::kInt32;
+    if (c.element_size == 1) return DType::kInt8;
   }
-  h5::Handle type = h5::checked(H5Tcreate(H5T_COMPOUND, element_size * width), H5Tclose, context);
-  h5::check(H5Tinsert(type.get(), member.c_str(), 0, field.get()), context);
-  h5::check(H5Dread(dataset, type.get(), H5S_ALL, H5S_ALL, H5P_DEFAULT, out),
-            context + ": cannot read");
+  if (c.element_class == H5T_INTEGER && !c.element_signed && c.element_size == 8) return DType::kUInt64;
+  throw TraceError(context + ", column " + quoted(c.name) + ": element type is not float64, int64, int32, int8 or uint64");
+}
+
+// One stored value of a column (dtype_of checked its type) as a double: integers exact to 2^53.
+double value_at(const unsigned char* p, DType dtype) {
+  switch (dtype) {
+    case DType::kFloat64: { double v; std::memcpy(&v, p, 8); return v; }
+    case DType::kInt64: { std::int64_t v; std::memcpy(&v, p, 8); return static_cast<double>(v); }
+    case DType::kInt32: { std::int32_t v; std::memcpy(&v, p, 4); return static_cast<double>(v); }
+    case DType::kInt8: { std::int8_t v; std::memcpy(&v, p, 1); return static_cast<double>(v); }
+    case DType::kUInt64: { std::uint64_t v; std::memcpy(&v, p, 8); return static_cast<double>(v); }
+  }
+  return 0.0;
+}
+
+// Columns `wanted` (indices into `layout`) of table `dataset`, every row: the table is read a
+// block of whole rows at a time (at most 4 MiB), each block decoded into every wanted column.
+std::vector<Dataset> read_columns(hid_t dataset, const h5::TableLayout& layout, const std::vector<std::size_t>& wanted,
+                                  const std::string& context) {
+  h5::Handle space = h5::checked(H5Dget_space(dataset), H5Sclose, context);
+  if (H5Sget_simple_extent_ndims(space.get()) != 1) throw TraceError(context + ": a table is 1-D");
+  hsize_t dims[1] = {0};
+  h5::check(H5Sget_simple_extent_dims(space.get(), dims, nullptr), context);
+  // Its extent, before anything is allocated for it: a damaged one may claim 2^64 rows.
+  h5::check_rows(dataset, dims[0], context);
+  const std::size_t rows = static_cast<std::size_t>(dims[0]);
+  std::vector<Dataset> out(wanted.size());
+  std::map<std::string, std::string> units;   // by attribute prefix: entity groups share them
+  for (std::size_t k = 0; k < wanted.size(); ++k) {
+    const h5::StoredColumn& c = layout.columns[wanted[k]];
+    Dataset& d = out[k];
+    d.dtype = dtype_of(c, context);
+    d.shape.push_back(rows);
+    if (c.width > 1) d.shape.push_back(c.width);
+    d.values.resize(rows * c.width);
+    if (d.dtype == DType::kUInt64) d.bits.resize(rows * c.width);
+    const auto known = units.find(c.attributes);
+    if (known != units.end()) {
+      d.units = known->second;
+    } else {
+      const std::string key = c.attributes + "/units";
+      d.units = h5::has_attribute(dataset, key, context) ? h5::read_string_attribute(dataset, key, context) : "";
+      units.emplace(c.attributes, d.units);
+    }
+  }
+  if (rows == 0 || wanted.empty()) return out;
+  const std::size_t block = std::clamp<std::size_t>((4u << 20) / std::max<std::size_t>(layout.row_bytes, 1), 1, rows);
+  std::vector<unsigned char> buffer(block * layout.row_bytes);
+  for (std::size_t start = 0; start < rows; start += block) {
+    const hsize_t offset[1] = {start}, count[1] = {std::min(block, rows - start)};
+    h5::check(H5Sselect_hyperslab(space.get(), H5S_SELECT_SET, offset, nullptr, count, nullptr), context);
+    h5::Handle memory = h5::checked(H5Screate_simple(1, count, nullptr), H5Sclose, context);
+    h5::check(H5Dread(dataset, layout.native.get(), memory.get(), space.get(), H5P_DEFAULT, buffer.data()),
+              context + ": cannot read rows " + std::to_string(start) + " to " + std::to_string(start + count[0] - 1));
+    for (std::size_t k = 0; k < wanted.size(); ++k) {
+      const h5::StoredColumn& c = layout.columns[wanted[k]];
+      Dataset& d = out[k];
+      for (std::size_t r = 0; r < count[0]; ++r) {
+        const unsigned char* p = buffer.data() + r * layout.row_bytes + c.offset;
+        const std::size_t at = (start + r) * c.width;
+        for (std::size_t j = 0; j < c.width; ++j, p += c.element_size) {
+          d.values[at + j] = value_at(p, d.dtype);
+          if (d.dtype == DType::kUInt64) std::memcpy(&d.bits[at + j], p, 8);
+        }
+      }
+    }
+  }
+  return out;
+}
+
+// A dataset that is not a table (schema 2's columns, or any other), whole.
+Dataset read_plain(hid_t dataset, const std::string& context) {
+  h5::Handle space = h5::checked(H5Dget_space(dataset), H5Sclose, context);
+  const int rank = H5Sget_simple_extent_ndims(space.get());
+  if (rank < 0) throw TraceError(context + ": " + h5::last_error());
+  std::vector<hsize_t> dims(static_cast<std::size_t>(rank));
+  if (rank > 0) h5::check(H5Sget_simple_extent_dims(space.get(), dims.data(), nullptr), context);
+  // Its extent, before anything is allocated for it: a damaged one may claim 2^64 rows.
+  if (rank > 0) h5::check_rows(dataset, dims[0], context);
+  Dataset out;
+  h5::Handle type = h5::checked(H5Dget_type(dataset), H5Tclose, context);
+  out.dtype = dtype_of(type.get(), context);
+  std::size_t count = 1;
+  for (hsize_t d : dims) {
+    out.shape.push_back(static_cast<std::size_t>(d));
+    count *= static_cast<std::size_t>(d);
+  }
+  out.values.resize(count);
+  if (count > 0 && out.dtype == DType::kUInt64) {
+    out.bits.resize(count);
+    h5::check(H5Dread(dataset, H5T_NATIVE_UINT64, H5S_ALL, H5S_ALL, H5P_DEFAULT, out.bits.data()),
+              context + ": cannot read");
+    for (std::size_t i = 0; i < count; ++i) out.values[i] = static_cast<double>(out.bits[i]);
+  } else if (count > 0) {
+    h5::check(H5Dread(dataset, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, out.values.data()),
+              context + ": cannot read");
+  }
+  if (h5::has_attribute(dataset, "units", context)) out.units = h5::read_string_attribute(dataset, "units", context);
+  return out;
 }
 
 // read_dataset, but for running out of memory (a bound read_dataset turns into a TraceError).
@@ -123,62 +230,60 @@ Dataset read_dataset_checked(const std::string& file, const std::string& path) {
   if (where.member_prefix || H5Iget_type(where.object.get()) != H5I_DATASET) {
     throw TraceError(context + ": not a dataset");
   }
-  h5::Handle space = h5::checked(H5Dget_space(where.object.get()), H5Sclose, context);
-  const int rank = H5Sget_simple_extent_ndims(space.get());
-  if (rank < 0) throw TraceError(context + ": " + h5::last_error());
-  std::vector<hsize_t> dims(static_cast<std::size_t>(rank));
-  if (rank > 0) h5::check(H5Sget_simple_extent_dims(space.get(), dims.data(), nullptr), context);
+  if (where.member.empty()) return read_plain(where.object.get(), context);
+  // A column of a table: shape (n,) or (n, width).
+  const h5::TableLayout layout = h5::table_layout(where.object.get(), context, !where.own_member);
+  const std::size_t k = static_cast<std::size_t>(layout.find(where.member));
+  return std::move(read_columns(where.object.get(), layout, {k}, context).front());
+}
 
-  // Its extent, before anything is allocated for it: a damaged one may claim 2^64 rows.
-  if (rank > 0) h5::check_rows(where.object.get(), dims[0], context);
-  Dataset out;
-  if (!where.member.empty()) {
-    // A column of a table: shape (n,) or (n, width).
-    if (rank != 1) throw TraceError(context + ": its table is not 1-D");
-    const h5::Member m = h5::member_of(where.object.get(), where.member, context);
-    out.dtype = dtype_of(m.element.get(), context);
-    const std::size_t rows = static_cast<std::size_t>(dims[0]);
-    out.shape.push_back(rows);
-    if (m.width > 1) out.shape.push_back(m.width);
-    const std::size_t count = rows * m.width;
-    out.values.resize(count);
-    if (count > 0 && out.dtype == DType::kUInt64) {
-      out.bits.resize(count);
-      read_member(where.object.get(), where.member, H5T_NATIVE_UINT64, m.width,
-                          out.bits.data(), context);
-      for (std::size_t i = 0; i < count; ++i) out.values[i] = static_cast<double>(out.bits[i]);
-    } else if (count > 0) {
-      read_member(where.object.get(), where.member, H5T_NATIVE_DOUBLE, m.width,
-                          out.values.data(), context);
+// Paths below group `group` ("/servo" of a schema 2 trace) of every dataset, relative to it, sorted.
+std::vector<std::string> datasets_in(hid_t group, const std::string& context) {
+  std::vector<std::string> names;
+  const auto collect = [](hid_t, const char* name, const H5O_info_t* info, void* data) -> herr_t {
+    if (info->type == H5O_TYPE_DATASET) static_cast<std::vector<std::string>*>(data)->push_back(name);
+    return 0;
+  };
+  h5::check(H5Ovisit2(group, H5_INDEX_NAME, H5_ITER_INC, collect, &names, H5O_INFO_BASIC),
+            context + ": cannot list its datasets");
+  names.erase(std::remove(names.begin(), names.end(), "."), names.end());
+  std::sort(names.begin(), names.end());
+  return names;
+}
+
+Table read_table_checked(const std::string& file, const std::string& path, const std::vector<std::string>& names) {
+  h5::Lock lock;
+  h5::Quiet quiet;
+  const std::string context = "trace " + quoted(file) + ", table " + quoted(path);
+  h5::Handle handle = open_file(file);
+  Location where = locate(handle.get(), path, "trace " + quoted(file));
+  if (!where.object.valid()) throw TraceError("trace " + quoted(file) + ": no object " + quoted(path));
+  const bool dataset = H5Iget_type(where.object.get()) == H5I_DATASET;
+  if (!where.member.empty() || (dataset && !h5::is_table(where.object.get(), context)))
+    throw TraceError(context + ": not a table");
+  Table out;
+  if (dataset) {
+    const h5::TableLayout layout = h5::table_layout(where.object.get(), context);
+    out.names = names.empty() ? layout.sorted_names() : names;
+    std::map<std::string, std::size_t> index;
+    for (std::size_t k = 0; k < layout.columns.size(); ++k) index.emplace(layout.columns[k].name, k);
+    std::vector<std::size_t> wanted;
+    for (const std::string& n : out.names) {
+      const auto found = index.find(n);
+      if (found == index.end()) throw TraceError(context + ": no column " + quoted(n));
+      wanted.push_back(found->second);
     }
-    const std::string units = where.member + "/units";
-    if (h5::has_attribute(where.object.get(), units, context)) {
-      out.units = h5::read_string_attribute(where.object.get(), units, context);
-    }
+    out.columns = read_columns(where.object.get(), layout, wanted, context);
     return out;
   }
-
-  h5::Handle type = h5::checked(H5Dget_type(where.object.get()), H5Tclose, context);
-  out.dtype = dtype_of(type.get(), context);
-  std::size_t count = 1;
-  for (hsize_t d : dims) {
-    out.shape.push_back(static_cast<std::size_t>(d));
-    count *= static_cast<std::size_t>(d);
-  }
-  out.values.resize(count);
-  if (count > 0 && out.dtype == DType::kUInt64) {
-    out.bits.resize(count);
-    h5::check(H5Dread(where.object.get(), H5T_NATIVE_UINT64, H5S_ALL, H5S_ALL, H5P_DEFAULT,
-                      out.bits.data()),
-              context + ": cannot read");
-    for (std::size_t i = 0; i < count; ++i) out.values[i] = static_cast<double>(out.bits[i]);
-  } else if (count > 0) {
-    h5::check(H5Dread(where.object.get(), H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT,
-                      out.values.data()),
-              context + ": cannot read");
-  }
-  if (h5::has_attribute(where.object.get(), "units", context)) {
-    out.units = h5::read_string_attribute(where.object.get(), "units", context);
+  // A schema 2 table: a group of datasets, each read on its own.
+  out.names = names.empty() ? datasets_in(where.object.get(), context) : names;
+  for (const std::string& n : out.names) {
+    const htri_t found = H5Lexists(where.object.get(), n.c_str(), H5P_DEFAULT);
+    if (found <= 0) throw TraceError(context + ": no column " + quoted(n));
+    h5::Handle d = h5::checked(H5Dopen2(where.object.get(), n.c_str(), H5P_DEFAULT), H5Dclose,
+                               context + ": column " + quoted(n) + " is not a dataset");
+    out.columns.push_back(read_plain(d.get(), context + ", column " + quoted(n)));
   }
   return out;
 }
@@ -193,10 +298,35 @@ Dataset read_dataset(const std::string& file, const std::string& path) {
   }
 }
 
+const Dataset& Table::column(const std::string& name) const {
+  if (sorted.size() == names.size()) {
+    const auto at = std::lower_bound(sorted.begin(), sorted.end(), name,
+                                     [this](std::size_t k, const std::string& n) { return names[k] < n; });
+    if (at != sorted.end() && names[*at] == name) return columns[*at];
+  } else {
+    for (std::size_t k = 0; k < names.size(); ++k)
+      if (names[k] == name) return columns[k];
+  }
+  throw TraceError("table: no column " + quoted(name) + " was read");
+}
+
+Table read_table(const std::string& file, const std::string& table, const std::vector<std::string>& names) {
+  try {
+    Table out = read_table_checked(file, table, names);
+    out.sorted.resize(out.names.size());
+    for (std::size_t k = 0; k < out.sorted.size(); ++k) out.sorted[k] = k;
+    std::sort(out.sorted.begin(), out.sorted.end(),
+              [&out](std::size_t a, std::size_t b) { return out.names[a] < out.names[b]; });
+    return out;
+  } catch (const std::bad_alloc&) {
+    throw TraceError("trace " + quoted(file) + ", table " + quoted(table) + ": not enough memory to read it");
+  }
+}
+
 namespace {
 
 struct Visit {
-  std::vector<std::string> paths;
+  std::vector<std::string> tables, plain;   // paths of the table datasets, and of the others
   std::string context;
   std::string error;   // the first failure (an exception may not cross the HDF5 C frames)
 };
@@ -207,14 +337,20 @@ herr_t visit_object(hid_t file, const char* name, const H5O_info_t* info, void* 
   const std::string path = std::string("/") + name;
   try {
     h5::Handle d = h5::checked(H5Dopen2(file, name, H5P_DEFAULT), H5Dclose, visit->context + ": cannot open " + quoted(path));
-    const std::vector<std::string> members = h5::member_names(d.get(), visit->context);
-    if (members.empty()) visit->paths.push_back(path);
-    for (const std::string& m : members) visit->paths.push_back(path + "/" + m);
+    (h5::is_table(d.get(), visit->context) ? visit->tables : visit->plain).push_back(path);
   } catch (const TraceError& e) {
     visit->error = e.what();
     return -1;
   }
   return 0;
+}
+
+Visit visit_datasets(hid_t file, const std::string& context) {
+  Visit visit{{}, {}, context, ""};
+  const herr_t status = H5Ovisit2(file, H5_INDEX_NAME, H5_ITER_INC, visit_object, &visit, H5O_INFO_BASIC);
+  if (!visit.error.empty()) throw TraceError(visit.error);
+  h5::check(status, context + ": cannot list its datasets");
+  return visit;
 }
 
 }  // namespace
@@ -223,12 +359,37 @@ std::vector<std::string> list_datasets(const std::string& file) {
   h5::Lock lock;
   h5::Quiet quiet;
   h5::Handle handle = open_file(file);
-  Visit visit{{}, "trace " + quoted(file), ""};
-  const herr_t status = H5Ovisit2(handle.get(), H5_INDEX_NAME, H5_ITER_INC, visit_object, &visit, H5O_INFO_BASIC);
-  if (!visit.error.empty()) throw TraceError(visit.error);
-  h5::check(status, visit.context + ": cannot list its datasets");
-  std::sort(visit.paths.begin(), visit.paths.end());
-  return visit.paths;
+  const std::string context = "trace " + quoted(file);
+  const Visit visit = visit_datasets(handle.get(), context);
+  std::vector<std::string> paths = visit.plain;
+  for (const std::string& t : visit.tables) {
+    h5::Handle d = h5::checked(H5Dopen2(handle.get(), t.c_str(), H5P_DEFAULT), H5Dclose, context + ": cannot open " + quoted(t));
+    for (const h5::StoredColumn& c : h5::table_layout(d.get(), context + ", table " + quoted(t)).columns)
+      paths.push_back(t + "/" + c.name);
+  }
+  std::sort(paths.begin(), paths.end());
+  return paths;
+}
+
+std::vector<std::pair<std::string, Dataset>> read_trace(const std::string& file) {
+  std::vector<std::string> tables, plain;
+  {
+    h5::Lock lock;
+    h5::Quiet quiet;
+    h5::Handle handle = open_file(file);
+    Visit visit = visit_datasets(handle.get(), "trace " + quoted(file));
+    tables = std::move(visit.tables);
+    plain = std::move(visit.plain);
+  }
+  std::vector<std::pair<std::string, Dataset>> out;
+  for (const std::string& t : tables) {
+    Table table = read_table(file, t);
+    for (std::size_t k = 0; k < table.names.size(); ++k)
+      out.emplace_back(t + "/" + table.names[k], std::move(table.columns[k]));
+  }
+  for (const std::string& p : plain) out.emplace_back(p, read_dataset(file, p));
+  std::sort(out.begin(), out.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+  return out;
 }
 
 namespace {
@@ -241,7 +402,7 @@ std::pair<h5::Handle, std::string> attribute_of(hid_t file, const std::string& f
   const std::string context = "trace " + quoted(file_name);
   Location where = locate(file, object_path, context);
   if (!where.object.valid()) throw TraceError(context + ": no object " + quoted(object_path));
-  std::string key = where.member.empty() ? name : where.member + "/" + name;
+  std::string key = where.member.empty() ? name : where.attributes + "/" + name;
   return {std::move(where.object), std::move(key)};
 }
 

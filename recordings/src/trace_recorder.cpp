@@ -14,6 +14,7 @@ namespace graspsim::recordings {
 namespace {
 
 using schema::declare;
+using schema::declare_group;
 using schema::Field;
 using schema::fill;
 using schema::size_of_fields;
@@ -50,7 +51,7 @@ std::vector<schema::ColumnDoc> schema::recorded_columns() {
     return path;
   };
   const std::string servo = under(kServo), haptic = under(kHaptic), physics = under(kPhysics);
-  const std::string finger = std::string(kFingers) + "<finger>/", object = std::string(kObjects) + "<object>/";
+  const std::string finger = std::string(kFingers) + "/<finger>/", object = std::string(kObjects) + "/<object>/";
   document(out, servo, kLoopFields);
   document(out, servo + finger, kServoFingerFields);
   document(out, haptic, kLoopFields);
@@ -109,21 +110,23 @@ TraceRecorder::TraceRecorder(TraceWriter& writer, const graspsim::Model& model,
     physics_loop_ = declare(*physics_, "", schema::kLoopFields);
     physics_hash_ = declare(*physics_, "", schema::kPhysicsFields);
   }
-  for (const auto& finger : model.fingers) {
-    const std::string prefix = std::string(schema::kFingers) + finger.name + "/";
-    servo_fingers_.push_back(servo_ ? declare(*servo_, prefix, schema::kServoFingerFields) : 0);
-    haptic_fingers_.push_back(haptic_ ? declare(*haptic_, prefix, schema::kHapticFingerFields) : 0);
-  }
+  // Fingers and bodies as entity groups: one member of the row each, whatever their number.
+  std::vector<std::string> fingers, bodies;
+  for (const auto& f : model.fingers) fingers.push_back(f.name);
+  for (const auto& b : model.bodies) bodies.push_back(b.name);
+  const auto group = [](TraceTable* t, std::string_view name, const std::vector<std::string>& entities,
+                        const auto& fields, std::vector<std::size_t>& offsets) {
+    const std::size_t first = t && !entities.empty() ? declare_group(*t, std::string(name), entities, fields) : 0;
+    const std::size_t stride = size_of_fields(fields).values;
+    for (std::size_t k = 0; k < entities.size(); ++k) offsets.push_back(t ? first + k * stride : 0);
+  };
+  group(servo_, schema::kFingers, fingers, schema::kServoFingerFields, servo_fingers_);
+  group(haptic_, schema::kFingers, fingers, schema::kHapticFingerFields, haptic_fingers_);
+  group(physics_, schema::kObjects, bodies, schema::kBodyFields, objects_);
   if (haptic_) {
-    std::string bodies;
-    for (std::size_t k = 0; k < model.bodies.size(); ++k) {
-      bodies += (k > 0 ? "\n" : "") + model.bodies[k].name;
-    }
-    haptic_->set_attribute(".", "bodies", bodies);
-  }
-  for (const auto& body : model.bodies) {
-    objects_.push_back(physics_ ? declare(*physics_, std::string(schema::kObjects) + body.name + "/", schema::kBodyFields)
-                                : 0);
+    std::string names;
+    for (std::size_t k = 0; k < bodies.size(); ++k) names += (k > 0 ? "\n" : "") + bodies[k];
+    haptic_->set_attribute(".", "bodies", names);
   }
 }
 

@@ -50,19 +50,25 @@ void TraceWriter::Impl::freeze() {
   {
     // Checked here, before the writer thread exists, so a table HDF5 cannot store fails at the
     // first row, not at close: a compound type is stored in one object header message, at most
-    // 64 KiB (about 90 objects of /physics with short names).
+    // 64 KiB (a group counts once, however many entities it has), and a chunk holds less than
+    // 4 GiB.
     h5::Lock lock;
     h5::Quiet quiet;
     for (auto& [name, table] : tables) {
       TraceTable::Impl& t = *table->impl_;
       const std::string where = context() + ": cannot create table " + quoted("/" + name);
       if (t.columns.empty()) throw TraceError(where + ": it has no columns");
-      const std::size_t encoded = encoded_row_type_bytes(t.columns);
+      const std::size_t encoded = encoded_row_type_bytes(t.columns, t.groups);
       if (encoded > kMaxRowTypeBytes) {
         throw TraceError(where + ": its " + std::to_string(t.columns.size()) + " columns need a " +
                          std::to_string(encoded) + "-byte HDF5 row type, more than the " +
                          std::to_string(kMaxRowTypeBytes) +
-                         " an object header holds (fewer objects or fingers, or shorter names)");
+                         " an object header holds (fewer columns, or shorter names)");
+      }
+      if (t.packed_width > kMaxChunkBytes / t.block_rows) {
+        throw TraceError(where + ": a chunk of " + std::to_string(t.block_rows) + " rows of " +
+                         std::to_string(t.packed_width) + " bytes is more than HDF5's chunk limit of " +
+                         std::to_string(kMaxChunkBytes) + " bytes (4 GiB - 1)");
       }
     }
   }

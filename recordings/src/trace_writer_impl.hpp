@@ -57,7 +57,8 @@ struct TraceTable::Impl {
   std::string name;              // dataset path without the leading '/': "servo"
   std::size_t block_rows = 0;    // rows per block, and rows per chunk
   writer::TraceFileState* file = nullptr;   // owned by the writer
-  std::vector<writer::Column> columns;
+  std::vector<writer::Column> columns;   // every column, a group's one per entity and field
+  std::vector<writer::Group> groups;     // in declaration order
   std::vector<std::pair<std::string, std::string>> attributes;   // name, value; in call order
   std::size_t row_width = 0;     // doubles per row
   std::size_t packed_width = 0;  // bytes per compound row

@@ -62,7 +62,9 @@ n = servo.shape[0]
 tick = servo["tick"]
 assert (tick == numpy.arange(n)).all()
 assert (servo["time"] == tick / 3000.0).all()
-assert servo["fingers/thumb/hip"].shape == (n, 3)
+fingers = servo.attrs["fingers"].split("\n")
+assert fingers == ["thumb", "index"], fingers
+assert servo["fingers"].shape == (n, 2) and servo["fingers"]["hip"].shape == (n, 2, 3)
 print(n)
 )PY";
 

@@ -138,3 +138,19 @@ TEST_CASE("a run is refused when its memory or its uncompressed disk will not fi
   CHECK(app::refusal(need, app::MachineRoom{4e9, 5e10}, 6, &warning).empty());
   CHECK_THAT(warning, Contains("compressed it may fit"));
 }
+
+// A table whose chunk (one flush interval of its rows) would pass HDF5's 4 GiB chunk limit is
+// refused whatever the machine has, naming the table and the limit: 360 /servo rows of 96 bytes
+// a finger pass it at 124,276 fingers (recordings/README.md "Limits").
+TEST_CASE("a run whose trace table would need chunks over HDF5's 4 GiB is refused, naming the table",
+          "[e2e][run_budget]") {
+  app::RunFootprint need;
+  need.tables.push_back({"/servo", 12 * 124276 + 2, 96 * 124276 + 16, 360.0, 12000.0});
+  std::string warning;
+  CHECK_THAT(app::refusal(need, app::MachineRoom{-1.0, -1.0}, 0, &warning),
+             Contains("/servo table would need chunks of 4.3 GB (360 rows of 11.9 MB)") &&
+                 Contains("HDF5's limit of 4.3 GB (2^32 - 1 bytes) a chunk"));
+  need.tables.back().values = 12 * 124275 + 2;
+  need.tables.back().bytes = 96 * 124275 + 16;
+  CHECK(app::refusal(need, app::MachineRoom{-1.0, -1.0}, 0, &warning).empty());
+}

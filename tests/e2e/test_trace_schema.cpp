@@ -106,35 +106,65 @@ struct Found {
   std::vector<std::string> units_missing;   // datasets without a units attribute
 };
 
+// The entity names of group `member` of table `path`: its attribute of that name, one a line.
+std::vector<std::string> entities(const inspect::File& h5, const std::string& path, const std::string& member) {
+  std::vector<std::string> names;
+  std::stringstream in(h5.read_string_attribute(path, member));
+  for (std::string line; std::getline(in, line);) names.push_back(line);
+  return names;
+}
+
+// A column of the table at `path`: its row (path, shape, dtype, units); a missing units attribute
+// is noted.
+void add_column(Found& f, const inspect::File& h5, const std::string& path, const std::string& column,
+                const inspect::Member& m, const std::string& units_key) {
+  const bool array = m.type.type_class == inspect::TypeClass::kArray;
+  const std::string shape = array ? "(n," + std::to_string(m.width) + ")" : "(n)";
+  std::string units = "(none)";
+  if (h5.has_attribute(path, units_key)) units = h5.read_string_attribute(path, units_key);
+  else f.units_missing.push_back(path + "/" + column);
+  f.datasets.insert({generic(path + "/" + column), shape, type_name(m.element), units});
+}
+
 // Every object of the file, read through the schema-free view (not the trace reader). A table is
 // one compound dataset of shape (n); each member is a column, an array member of width w a column
-// of shape (n,w); its units are attribute "<member>/units". An attribute of a table dataset named
-// "<column>/<name>" belongs to that column (schema 3); "units" of every column is listed once, as
-// "every column".
+// of shape (n,w); its units are attribute "<member>/units". A member that is an array of compound
+// elements is a group of entities (schema 4): the table's attribute of its name lists them, and
+// field f of entity e is column "<member>/<e>/<f>", its attributes "<member>/<f>/<name>". An
+// attribute of a table dataset named "<column>/<name>" belongs to that column; "units" of every
+// column is listed once, as "every column".
 Found visit(const std::string& file) {
   Found f;
   const inspect::File h5 = inspect::File::open(file);
   for (const inspect::Object& object : h5.objects()) {
     const std::string& path = object.path;
     const bool is_dataset = object.kind == inspect::ObjectKind::kDataset;
+    std::set<std::string> groups;
     if (is_dataset) {
       const inspect::DatasetInfo d = h5.dataset(path);
       const bool compound = d.type.type_class == inspect::TypeClass::kCompound;
       if (d.dims.size() != 1 || !compound) f.datasets.insert({generic(path), "not a table", "?", "?"});
       for (const inspect::Member& m : d.members) {
-        const bool array = m.type.type_class == inspect::TypeClass::kArray;
-        const std::string shape = array ? "(n," + std::to_string(m.width) + ")" : "(n)";
-        std::string units = "(none)";
-        const std::string key = m.name + "/units";
-        if (h5.has_attribute(path, key)) units = h5.read_string_attribute(path, key);
-        else f.units_missing.push_back(path + "/" + m.name);
-        f.datasets.insert({generic(path + "/" + m.name), shape, type_name(m.element), units});
+        if (m.fields.empty()) {
+          add_column(f, h5, path, m.name, m, m.name + "/units");
+          continue;
+        }
+        groups.insert(m.name);
+        const std::vector<std::string> names = entities(h5, path, m.name);
+        CHECK(names.size() == m.width);
+        for (const std::string& e : names)
+          for (const inspect::Member& field : m.fields)
+            add_column(f, h5, path, m.name + "/" + e + "/" + field.name, field, m.name + "/" + field.name + "/units");
       }
     }
     for (const inspect::Attribute& a : h5.attributes(path)) {
       const auto slash = a.name.rfind('/');
+      const auto first = a.name.find('/');
       if (is_dataset && slash != std::string::npos) {
-        const std::string column = path + "/" + a.name.substr(0, slash), key = a.name.substr(slash + 1);
+        // A group's field attribute names the field's column of every entity.
+        std::string column = path + "/" + a.name.substr(0, slash);
+        if (groups.count(a.name.substr(0, first))) column = path + "/" + a.name.substr(0, first) + "/<entity>" + a.name.substr(first, slash - first);
+        const std::string key = a.name.substr(slash + 1);
         if (key == "units") f.attributes.insert({"every column", "units", type_name(a.type)});
         else f.attributes.insert({generic(column), key, type_name(a.type)});
       } else {

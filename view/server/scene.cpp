@@ -5,12 +5,14 @@
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
+#include <map>
 #include <optional>
 #include <set>
 #include <sstream>
 
 #include "graspsim/recordings/trace_reader.hpp"
 #include "graspsim/recordings/trace_recorder.hpp"
+#include "graspsim/recordings/trace_schema.hpp"
 #include "graspsim/scripting/scenario.hpp"
 
 namespace graspsim::view {
@@ -30,11 +32,17 @@ std::string root_string(const std::string& trace, const std::string& name, const
   return rec::has_attribute(trace, "/", name) ? rec::read_string_attribute(trace, "/", name) : fallback;
 }
 
-// A whole column, checked to hold `width` values per row.
+// The columns the viewer reads, by path ("/physics/objects/box/position"): each table read once,
+// only the columns asked for (a 1000-body /physics is one pass over its rows, not 6000).
+using Loaded = std::map<std::string, rec::Dataset>;
+
 // Column `path`, `width` values a row, at least `rows` rows (a cut schema-2 trace's columns can
-// end apart; schema 3 keeps a table's columns in one row).
-rec::Dataset column(const std::string& trace, const std::string& path, std::size_t width, std::size_t rows = 0) {
-  rec::Dataset d = rec::read_dataset(trace, path);
+// end apart; schema 3 and 4 keep a table's columns in one row).
+const rec::Dataset& column(const Loaded& loaded, const std::string& trace, const std::string& path, std::size_t width,
+                           std::size_t rows = 0) {
+  const auto found = loaded.find(path);
+  if (found == loaded.end()) throw ViewError(trace + ": no column " + path);
+  const rec::Dataset& d = found->second;
   const std::size_t w = d.shape.size() == 2 ? d.shape[1] : 1;
   if (w != width || d.shape.empty())
     throw ViewError(trace + ": " + path + ": expected " + std::to_string(width) + " values per row");
@@ -44,8 +52,8 @@ rec::Dataset column(const std::string& trace, const std::string& path, std::size
   return d;
 }
 
-std::vector<std::int64_t> ticks(const std::string& trace, const std::string& table) {
-  const rec::Dataset d = column(trace, "/" + table + "/tick", 1);
+std::vector<std::int64_t> ticks(const Loaded& loaded, const std::string& trace, const std::string& table) {
+  const rec::Dataset& d = column(loaded, trace, "/" + table + "/tick", 1);
   return {d.values.begin(), d.values.end()};
 }
 
@@ -103,8 +111,9 @@ void require_trace(const std::string& trace) {
   }
   if (!is_trace) throw ViewError(trace + ": not a graspsim trace (no root attribute 'schema_version')");
   const std::int64_t schema = rec::read_int_attribute(trace, "/", "schema_version");
-  if (schema < 2 || schema > rec::kSchemaVersion)
-    throw ViewError(trace + ": schema_version " + std::to_string(schema) + " is not one this graspsim reads (2 to " +
+  if (schema < rec::kOldestSchemaVersion || schema > rec::kSchemaVersion)
+    throw ViewError(trace + ": schema_version " + std::to_string(schema) + " is not one this graspsim reads (" +
+                    std::to_string(rec::kOldestSchemaVersion) + " to " +
                     std::to_string(rec::kSchemaVersion) + ")");
   for (const char* table : {"/physics", "/haptic", "/servo"}) {
     if (rec::has_object(trace, table)) continue;
@@ -116,9 +125,45 @@ void require_trace(const std::string& trace) {
   }
 }
 
-void load_columns(ViewScene& s, const std::vector<std::string>& columns) {
+// The quantities the page draws and plots, per body and per finger.
+constexpr const char* kBodyColumns[] = {"position", "quaternion", "grasp_area", "torsion", "floor_contacts",
+                                        "body_contacts"};
+constexpr const char* kFingerColumns[] = {"god_object", "force", "state", "surface_point", "friction_radius",
+                                          "depth", "slip", "body"};
+constexpr const char* kContactColumns[] = {"tick", "a", "b", "point", "force"};
+
+// Reads the columns the page needs that the trace holds (`columns`, list_datasets'), a table at a time.
+Loaded load_tables(const ViewScene& s, const std::vector<std::string>& columns) {
+  using rec::schema::finger_column;
+  using rec::schema::object_column;
+  std::map<std::string, std::vector<std::string>> wanted;   // table -> its columns
+  const auto want = [&](std::string_view table, const std::string& name) {
+    std::string path = "/";   // built by appends: GCC 12 warns (-Wrestrict) on "/" + ... + "/" here
+    path.append(table).append("/").append(name);
+    if (std::binary_search(columns.begin(), columns.end(), path)) wanted[std::string(table)].push_back(name);
+  };
+  for (std::string_view table : {rec::schema::kPhysics, rec::schema::kHaptic, rec::schema::kServo}) want(table, "tick");
+  for (const BodyView& b : s.bodies)
+    for (const char* q : kBodyColumns) want(rec::schema::kPhysics, object_column(b.name, q));
+  for (const FingerView& f : s.fingers) {
+    for (const char* q : kFingerColumns) want(rec::schema::kHaptic, finger_column(f.name, q));
+    want(rec::schema::kServo, finger_column(f.name, "hip"));
+  }
+  for (const char* q : kContactColumns) want(rec::schema::kContacts, q);
+  Loaded loaded;
+  for (auto& [table, names] : wanted) {
+    rec::Table t = rec::read_table(s.trace, "/" + table, names);
+    for (std::size_t k = 0; k < names.size(); ++k) loaded.emplace("/" + table + "/" + names[k], std::move(t.columns[k]));
+  }
+  return loaded;
+}
+
+void load_columns(ViewScene& s, const Loaded& loaded) {
+  using rec::schema::finger_column;
+  using rec::schema::object_column;
   const std::string& t = s.trace;
-  const std::vector<std::int64_t> physics = ticks(t, "physics"), haptic = ticks(t, "haptic"), servo = ticks(t, "servo");
+  const std::vector<std::int64_t> physics = ticks(loaded, t, "physics"), haptic = ticks(loaded, t, "haptic"),
+                                  servo = ticks(loaded, t, "servo");
   if (physics.empty()) throw ViewError(t + ": the trace holds no /physics row yet: nothing to show");
   // The last tick every table holds (a cut trace's tables may end a flush interval apart).
   std::int64_t last = physics.back();
@@ -131,10 +176,10 @@ void load_columns(ViewScene& s, const std::vector<std::string>& columns) {
   s.physics_tick.assign(physics.begin(), physics.begin() + np);
   s.haptic_tick.assign(haptic.begin(), haptic.begin() + nh);
   for (BodyView& b : s.bodies) {
-    const std::string base = "/physics/objects/" + b.name + "/";
-    if (std::find(columns.begin(), columns.end(), base + "position") == columns.end())
+    const std::string base = "/physics/" + object_column(b.name, "");
+    if (!loaded.count(base + "position"))
       throw ViewError(t + ": no column " + base + "position for body '" + b.name + "'");
-    const rec::Dataset p = column(t, base + "position", 3, np), q = column(t, base + "quaternion", 4, np);
+    const rec::Dataset &p = column(loaded, t, base + "position", 3, np), &q = column(loaded, t, base + "quaternion", 4, np);
     b.position.assign(p.values.begin(), p.values.begin() + 3 * np);
     b.quaternion.assign(q.values.begin(), q.values.begin() + 4 * np);
   }
@@ -151,12 +196,13 @@ void load_columns(ViewScene& s, const std::vector<std::string>& columns) {
     servo_row[i] = static_cast<std::size_t>(it - servo.begin());
   }
   for (FingerView& f : s.fingers) {
-    const std::string h = "/haptic/fingers/" + f.name + "/";
+    const std::string h = "/haptic/" + finger_column(f.name, "");
     const std::size_t servo_rows = nh == 0 ? 0 : servo_row[nh - 1] + 1;
-    const rec::Dataset go = column(t, h + "god_object", 3, nh), force = column(t, h + "force", 3, nh),
-                       state = column(t, h + "state", 1, nh),
-                       hip = column(t, "/servo/fingers/" + f.name + "/hip", 3, servo_rows),
-                       surface = column(t, h + "surface_point", 3, nh), circle = column(t, h + "friction_radius", 1, nh);
+    const rec::Dataset &go = column(loaded, t, h + "god_object", 3, nh), &force = column(loaded, t, h + "force", 3, nh),
+                       &state = column(loaded, t, h + "state", 1, nh),
+                       &hip = column(loaded, t, "/servo/" + finger_column(f.name, "hip"), 3, servo_rows),
+                       &surface = column(loaded, t, h + "surface_point", 3, nh),
+                       &circle = column(loaded, t, h + "friction_radius", 1, nh);
     f.surface_point.assign(surface.values.begin(), surface.values.begin() + 3 * nh);
     f.friction_radius.assign(circle.values.begin(), circle.values.begin() + nh);
     f.god_object.assign(go.values.begin(), go.values.begin() + 3 * nh);
@@ -169,35 +215,34 @@ void load_columns(ViewScene& s, const std::vector<std::string>& columns) {
 
 // The columns the time series and the grasp axis read: the first `rows` values of `path`, or
 // zeros where an older trace lacks it.
-std::vector<double> plot_column(const std::string& trace, const std::vector<std::string>& columns,
-                                const std::string& path, std::size_t rows) {
-  if (std::find(columns.begin(), columns.end(), path) == columns.end()) return std::vector<double>(rows, 0.0);
-  const rec::Dataset d = column(trace, path, 1, rows);
+std::vector<double> plot_column(const ViewScene& s, const Loaded& loaded, const std::string& path, std::size_t rows) {
+  if (!loaded.count(path)) return std::vector<double>(rows, 0.0);
+  const rec::Dataset& d = column(loaded, s.trace, path, 1, rows);
   return {d.values.begin(), d.values.begin() + static_cast<std::ptrdiff_t>(rows)};
 }
 
-void load_plot_columns(ViewScene& s, const std::vector<std::string>& columns) {
+void load_plot_columns(ViewScene& s, const Loaded& loaded) {
   const std::size_t np = s.physics_tick.size(), nh = s.haptic_tick.size();
   for (BodyView& b : s.bodies) {
-    const std::string base = "/physics/objects/" + b.name + "/";
-    b.grasp_area = plot_column(s.trace, columns, base + "grasp_area", np);
-    b.torsion = plot_column(s.trace, columns, base + "torsion", np);
-    b.floor_contacts = plot_column(s.trace, columns, base + "floor_contacts", np);
-    b.body_contacts = plot_column(s.trace, columns, base + "body_contacts", np);
+    const std::string base = "/physics/" + rec::schema::object_column(b.name, "");
+    b.grasp_area = plot_column(s, loaded, base + "grasp_area", np);
+    b.torsion = plot_column(s, loaded, base + "torsion", np);
+    b.floor_contacts = plot_column(s, loaded, base + "floor_contacts", np);
+    b.body_contacts = plot_column(s, loaded, base + "body_contacts", np);
   }
   for (FingerView& f : s.fingers) {
-    const std::string h = "/haptic/fingers/" + f.name + "/";
-    f.depth = plot_column(s.trace, columns, h + "depth", nh);
-    f.slip = plot_column(s.trace, columns, h + "slip", nh);
-    f.body = plot_column(s.trace, columns, h + "body", nh);
+    const std::string h = "/haptic/" + rec::schema::finger_column(f.name, "");
+    f.depth = plot_column(s, loaded, h + "depth", nh);
+    f.slip = plot_column(s, loaded, h + "slip", nh);
+    f.body = plot_column(s, loaded, h + "body", nh);
   }
 }
 
 // /contacts rows up to the last kept physics tick, when the trace recorded them.
-void load_contacts(ViewScene& s) {
+void load_contacts(ViewScene& s, const Loaded& loaded) {
   const std::string& t = s.trace;
   if (!rec::has_object(t, "/contacts")) return;
-  const std::vector<std::int64_t> tick = ticks(t, "contacts");
+  const std::vector<std::int64_t> tick = ticks(loaded, t, "contacts");
   const std::int64_t last = s.physics_tick.empty() ? -1 : s.physics_tick.back();
   const std::size_t n = static_cast<std::size_t>(std::upper_bound(tick.begin(), tick.end(), last) - tick.begin());
   const auto first = [n](const rec::Dataset& d, std::size_t width) {
@@ -205,10 +250,10 @@ void load_contacts(ViewScene& s) {
   };
   s.contacts = true;
   s.contact_tick.assign(tick.begin(), tick.begin() + static_cast<std::ptrdiff_t>(n));
-  s.contact_a = first(column(t, "/contacts/a", 1, n), 1);
-  s.contact_b = first(column(t, "/contacts/b", 1, n), 1);
-  s.contact_point = first(column(t, "/contacts/point", 3, n), 3);
-  s.contact_force = first(column(t, "/contacts/force", 3, n), 3);
+  s.contact_a = first(column(loaded, t, "/contacts/a", 1, n), 1);
+  s.contact_b = first(column(loaded, t, "/contacts/b", 1, n), 1);
+  s.contact_point = first(column(loaded, t, "/contacts/point", 3, n), 3);
+  s.contact_force = first(column(loaded, t, "/contacts/force", 3, n), 3);
 }
 
 }  // namespace
@@ -252,9 +297,10 @@ ViewScene load_scene(const std::string& trace) {
       for (const std::string& b : names_under(columns, "/physics/objects/")) s.bodies.emplace_back().name = b;
       for (const std::string& f : names_under(columns, "/haptic/fingers/")) s.fingers.emplace_back().name = f;
     }
-    load_columns(s, columns);
-    load_plot_columns(s, columns);
-    load_contacts(s);
+    const Loaded loaded = load_tables(s, columns);
+    load_columns(s, loaded);
+    load_plot_columns(s, loaded);
+    load_contacts(s, loaded);
     if (s.status != "complete") s.note = cut_note(s);
     if (!scenario)
       s.note += (s.note.empty() ? "" : " ") + std::string("The recorded scenario does not load here (") + why +

@@ -12,16 +12,35 @@ import sys
 import h5py
 
 
+def columns(table):
+    """{column: array} of a table, its rows read once: a member is a column (schema 3,
+    "objects/box/position"); a member that is an array of compound elements (schema 4) is a group
+    of entities, named by the table's attribute of the member's name (one a line), field f of
+    entity e being column "<member>/<e>/<f>"."""
+    rows = table[:]
+    out = {}
+    for member in rows.dtype.names:
+        sub = rows.dtype[member].subdtype
+        if sub is None or sub[0].names is None:
+            out[member] = rows[member]
+            continue
+        names = table.attrs[member]
+        names = (names if isinstance(names, str) else names.decode()).split("\n")
+        for k, entity in enumerate(names):
+            for field in sub[0].names:
+                out[f"{member}/{entity}/{field}"] = rows[member][:, k][field]
+    return out
+
+
 def main(path):
     with h5py.File(path, "r", swmr=True) as f:
-        physics = f["physics"][:]
-        haptic = f["haptic"][:]
-        servo = f["servo"][:]
+        physics = columns(f["physics"])
+        haptic = columns(f["haptic"])
+        servo = columns(f["servo"])
         servo_row = {int(t): i for i, t in enumerate(servo["tick"])}
         at_haptic = [servo_row.get(int(t), 0) for t in haptic["tick"]]
-        names = physics.dtype.names
-        bodies = sorted({n.split("/")[1] for n in names if n.startswith("objects/")})
-        fingers = sorted({n.split("/")[1] for n in haptic.dtype.names if n.startswith("fingers/")})
+        bodies = sorted({n.split("/")[1] for n in physics if n.startswith("objects/")})
+        fingers = sorted({n.split("/")[1] for n in haptic if n.startswith("fingers/")})
         out = {
             "status": f.attrs["status"] if isinstance(f.attrs["status"], str) else f.attrs["status"].decode(),
             "physics_tick": physics["tick"].tolist(),

@@ -113,6 +113,42 @@ std::vector<Object> File::objects() const {
   return out;
 }
 
+namespace {
+
+// The members of compound type `type`; a member that is an array of compound elements (a
+// trace's entity group) lists the element's members as its `fields`.
+std::vector<Member> members_of(hid_t type, const std::string& at) {
+  std::vector<Member> out;
+  const int n = H5Tget_nmembers(type);
+  check(n, at);
+  for (unsigned k = 0; k < static_cast<unsigned>(n); ++k) {
+    Member m;
+    char* name = H5Tget_member_name(type, k);
+    if (name != nullptr) m.name = name;
+    H5free_memory(name);
+    const std::string here = at + ": member " + m.name;
+    h5::Handle member = own(H5Tget_member_type(type, k), H5Tclose, here);
+    m.type = detail::type_of(member.get());
+    m.element = m.type;
+    h5::Handle base;
+    if (m.type.type_class == TypeClass::kArray) {
+      const int array_rank = H5Tget_array_ndims(member.get());
+      check(array_rank, here);
+      std::vector<hsize_t> extent(static_cast<std::size_t>(array_rank));
+      check(H5Tget_array_dims2(member.get(), extent.data()), here);
+      for (hsize_t e : extent) m.width *= e;
+      base = own(H5Tget_super(member.get()), H5Tclose, here);
+      m.element = detail::type_of(base.get());
+    }
+    if (m.element.type_class == TypeClass::kCompound)
+      m.fields = members_of(base.valid() ? base.get() : member.get(), here);
+    out.push_back(std::move(m));
+  }
+  return out;
+}
+
+}  // namespace
+
 DatasetInfo File::dataset(const std::string& path) const {
   Guard guard;
   const std::string at = where(path_, path);
@@ -128,29 +164,7 @@ DatasetInfo File::dataset(const std::string& path) const {
 
   h5::Handle type = own(H5Dget_type(d.get()), H5Tclose, at);
   out.type = detail::type_of(type.get());
-  if (out.type.type_class == TypeClass::kCompound) {
-    const int n = H5Tget_nmembers(type.get());
-    check(n, at);
-    for (unsigned k = 0; k < static_cast<unsigned>(n); ++k) {
-      Member m;
-      char* name = H5Tget_member_name(type.get(), k);
-      if (name != nullptr) m.name = name;
-      H5free_memory(name);
-      h5::Handle member = own(H5Tget_member_type(type.get(), k), H5Tclose, at + ": member " + m.name);
-      m.type = detail::type_of(member.get());
-      m.element = m.type;
-      if (m.type.type_class == TypeClass::kArray) {
-        const int array_rank = H5Tget_array_ndims(member.get());
-        check(array_rank, at + ": member " + m.name);
-        std::vector<hsize_t> extent(static_cast<std::size_t>(array_rank));
-        check(H5Tget_array_dims2(member.get(), extent.data()), at + ": member " + m.name);
-        for (hsize_t e : extent) m.width *= e;
-        h5::Handle base = own(H5Tget_super(member.get()), H5Tclose, at + ": member " + m.name);
-        m.element = detail::type_of(base.get());
-      }
-      out.members.push_back(std::move(m));
-    }
-  }
+  if (out.type.type_class == TypeClass::kCompound) out.members = members_of(type.get(), at);
 
   h5::Handle dcpl = own(H5Dget_create_plist(d.get()), H5Pclose, at);
   out.chunked = H5Pget_layout(dcpl.get()) == H5D_CHUNKED;

@@ -44,12 +44,14 @@ struct Type {
 
 // One member of a compound type. An array member's `element` is its base type and `width` its
 // element count (the product of its dimensions); a scalar member's `element` is `type` and
-// `width` is 1.
+// `width` is 1. An element that is itself a compound (a trace's group of entities: an array of
+// one compound per body or finger) has its members in `fields`.
 struct Member {
   std::string name;
   Type type;
   Type element;
   std::uint64_t width = 1;
+  std::vector<Member> fields;
 };
 
 // One filter of a dataset's pipeline, in order: its id (kFilterDeflate, ...), its name as
@@ -134,10 +136,19 @@ class File {
   void write_member_row(const std::string& dataset, const std::string& member, std::uint64_t row,
                         const std::vector<double>& values);
 
+  // The same for field `field` of element `index` of member `member`, an array of compound
+  // elements: the member's row is read as stored, the field converted to doubles (H5Tconvert)
+  // and, written, converted back into the row, the rest of the member as it was.
+  std::vector<double> read_element_row(const std::string& dataset, const std::string& member, std::uint64_t index,
+                                       const std::string& field, std::uint64_t row) const;
+  void write_element_row(const std::string& dataset, const std::string& member, std::uint64_t index,
+                         const std::string& field, std::uint64_t row, const std::vector<double>& values);
+
   // Edits.
   void set_extent(const std::string& dataset, const std::vector<std::uint64_t>& dims);
-  // Rewrites compound dataset `dataset` without member `member`: the other members packed in
-  // order, every row kept; the copy is contiguous and has no attributes.
+  // Rewrites compound dataset `dataset` without member `member` (or, for "<m>/<field>" where
+  // <m> is an array of compound elements, without that field of every element): the other
+  // members packed in order, every row kept; the copy is contiguous and keeps the attributes.
   void drop_member(const std::string& dataset, const std::string& member);
   void create_group(const std::string& path);
   // A 1-D chunked dataset of `values` (little-endian int64 or float64) with unlimited rows.

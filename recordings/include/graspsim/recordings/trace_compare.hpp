@@ -15,7 +15,7 @@
 namespace graspsim::recordings {
 
 // The traces cannot be compared: a file missing or not HDF5 or truncated, not a graspsim
-// trace, schema versions or rates that differ, no table both hold (after `only`), a column of a
+// trace, schema versions that differ (unless both are ones this graspsim reads), rates that differ, no table both hold (after `only`), a column of a
 // shared table in one trace only, different widths or element kinds, a --tol pattern or an
 // `only` loop that matches nothing. what() names the file and the dataset.
 class CompareInputError : public TraceError {
@@ -107,7 +107,8 @@ struct OneSidedTable {
 struct CompareResult {
   std::string file_a, file_b;
   CompareOptions options;                       // what was asked
-  std::int64_t schema_version = 0;
+  std::int64_t schema_version = 0;              // A's
+  std::int64_t schema_version_b = 0;            // B's: another only where both are readable (2 to 4)
   std::int64_t rate_servo = 0, rate_haptic = 0, rate_physics = 0;   // Hz
   std::vector<LoopAlignment> loops;             // servo, haptic, physics, then any other table
   std::vector<OneSidedTable> one_sided;         // selected tables in one trace only, in loop order

@@ -17,9 +17,14 @@
 namespace graspsim::recordings {
 
 // The trace schema this graspsim writes (root attribute "schema_version", recordings/README.md).
-// 3: one compound dataset per loop (/servo, /haptic, /physics), one member per column.
-// 2: one group per loop, one dataset per column. Readers here read both.
-inline constexpr std::int64_t kSchemaVersion = 3;
+// 4: one compound dataset per loop (/servo, /haptic, /physics); the per-finger and per-object
+//    columns stored as one member per group, an array of one compound element per finger or
+//    object, so the row type does not grow with them.
+// 3: the same, one member per column (fingers/thumb/hip, ...).
+// 2: one group per loop, one dataset per column. Readers here read all three.
+inline constexpr std::int64_t kSchemaVersion = 4;
+// The oldest schema this graspsim reads (and replays).
+inline constexpr std::int64_t kOldestSchemaVersion = 2;
 
 // One row of a table: doubles in the writer's memory blocks, bytes in the file.
 struct RowSize {

@@ -155,8 +155,19 @@ inline constexpr std::string_view kServo = "servo";        // every servo tick
 inline constexpr std::string_view kHaptic = "haptic";      // every haptic tick
 inline constexpr std::string_view kPhysics = "physics";    // every physics tick
 inline constexpr std::string_view kContacts = "contacts";  // a row per contact point per physics tick
-inline constexpr std::string_view kFingers = "fingers/";   // + <finger>/ + field
-inline constexpr std::string_view kObjects = "objects/";   // + <object>/ + field
+// The entity groups (TraceTable::add_group): columns fingers/<finger>/<field> of /servo and
+// /haptic, objects/<object>/<field> of /physics.
+inline constexpr std::string_view kFingers = "fingers";
+inline constexpr std::string_view kObjects = "objects";
+
+// A column of one entity, relative to its table, as every reader names it whatever the layout
+// (trace_reader.hpp): "fingers/thumb/hip" of /servo, "objects/box/position" of /physics.
+inline std::string finger_column(std::string_view finger, std::string_view field) {
+  return std::string(kFingers) + "/" + std::string(finger) + "/" + std::string(field);
+}
+inline std::string object_column(std::string_view object, std::string_view field) {
+  return std::string(kObjects) + "/" + std::string(object) + "/" + std::string(field);
+}
 
 inline constexpr Field<LoopRow> kLoopFields[] = {
     field<&LoopRow::tick>("tick", "tick"),

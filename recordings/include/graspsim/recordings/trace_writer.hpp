@@ -10,6 +10,7 @@
 #include <memory>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 namespace graspsim::recordings {
 
@@ -46,13 +47,18 @@ constexpr const char* name_of(DType dtype) {
   return "?";
 }
 
+// The most bytes HDF5 stores in one chunk (2^32 - 1): a table's chunk, `block_rows` rows, must
+// fit in it, which bounds one row of a table to just under 4 GiB (recordings/README.md "Limits").
+inline constexpr std::size_t kMaxChunkBytes = 0xFFFFFFFFu;   // bytes
+
 // The row value of a kUInt64 column: the 64 bits of `value` carried in a double, unchanged
 // (written back bit for bit; never do arithmetic on it).
 inline double uint64_in_row(std::uint64_t value) { return std::bit_cast<double>(value); }
 
-// A table: one HDF5 dataset of compound rows, one member per column, so its columns can never
-// drift apart, not even in a file cut by a crash (the H5MD lesson, taken one step further than
-// a group of datasets). Owned by a TraceWriter.
+// A table: one HDF5 dataset of compound rows, one member per column (or per group of columns
+// repeated per entity: add_group), so its columns can never drift apart, not even in a file cut
+// by a crash (the H5MD lesson, taken one step further than a group of datasets). Owned by a
+// TraceWriter.
 class TraceTable {
  public:
   struct Impl;   // opaque
@@ -69,6 +75,27 @@ class TraceTable {
   // used twice, or width < 1.
   std::size_t add_column(const std::string& path, int width, DType dtype,
                          const std::string& units);
+  // One field of the entities of a group (add_group): its path below the entity ("position"),
+  // values per row, stored type and units.
+  struct Field {
+    std::string name;
+    int width = 1;
+    DType dtype = DType::kFloat64;
+    std::string units;
+  };
+  // Declares the columns "<group>/<entity>/<field>" of every entity (a body, a finger) and field,
+  // entity by entity in the order given, fields in order: readers see each as add_column's. They
+  // are stored as one member `group` of the row, an array of one compound element per entity with
+  // a member per field, so the row type stays the same size however many entities there are
+  // (recordings/README.md "Schema"); the table gets string attribute `group` = the entity names
+  // joined by newlines, and per field "<group>/<field>/units" (a field's other attributes:
+  // set_attribute("<group>/<field>", ...)). Returns the offset into a row of the first entity's
+  // first field; entity k's fields follow at that offset + k * (the fields' widths summed), in
+  // field order. Only before the first row (as add_column); throws TraceError for no entity, a
+  // name that cannot be a path component or has a newline, one used twice, a field path that is
+  // not relative or width < 1, or a group path that clashes with a column.
+  std::size_t add_group(const std::string& group, const std::vector<std::string>& entities,
+                        const std::vector<Field>& fields);
   // Pointer to the next row: row_width() doubles in column order; the caller fills all of them.
   // Valid until the next append_row/flush. Integer columns are stored as doubles in the row and
   // converted when the block is written (exact up to 2^53); a value that is not an integer in
@@ -82,9 +109,11 @@ class TraceTable {
   std::size_t row_width() const;   // doubles per row
   std::int64_t rows() const;       // rows appended so far (flushed or not)
   void flush();                    // writes buffered rows and waits for the writer
-  // String attribute of the table ("."; stored as attribute `name` of the dataset) or of one of
-  // its columns (stored as attribute "<column>/<name>"). Only before the file's first row
-  // (throws TraceError after it, for an unknown column, or a name that is empty or has '/').
+  // String attribute of the table ("."; stored as attribute `name` of the dataset), of one of
+  // its columns (stored as attribute "<column>/<name>"), or of a field of a group's entities,
+  // "<group>/<field>" (stored as "<group>/<field>/<name>", one for every entity). Only before the
+  // file's first row (throws TraceError after it, for an unknown column, a column of a group's
+  // entity, or a name that is empty or has '/').
   void set_attribute(const std::string& dataset_or_dot, const std::string& name,
                      const std::string& value);
 
