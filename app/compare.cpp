@@ -5,6 +5,8 @@
 #include <cstdio>
 #include <sstream>
 
+#include "app/json.hpp"
+
 namespace graspsim::app {
 namespace {
 
@@ -68,28 +70,6 @@ std::string tolerance_text(const recordings::Tolerance& t) {
 }
 
 // --- JSON ------------------------------------------------------------------------------------
-
-std::string json_string(const std::string& s) {
-  std::string out = "\"";
-  for (const unsigned char c : s) {
-    switch (c) {
-      case '"': out += "\\\""; break;
-      case '\\': out += "\\\\"; break;
-      case '\n': out += "\\n"; break;
-      case '\r': out += "\\r"; break;
-      case '\t': out += "\\t"; break;
-      default:
-        if (c < 0x20) {
-          char buf[8];
-          std::snprintf(buf, sizeof buf, "\\u%04x", c);
-          out += buf;
-        } else {
-          out += static_cast<char>(c);
-        }
-    }
-  }
-  return out + "\"";
-}
 
 // Finite numbers exactly (%.17g); inf, -inf and nan as the strings "inf", "-inf", "nan".
 std::string json_number(double x) {

@@ -11,6 +11,8 @@
 #include <fstream>
 #include <string>
 #include <sys/wait.h>
+
+#include "app/json.hpp"
 #include "tests/support/shell.hpp"
 #include "tests/support/trace_edit.hpp"
 
@@ -235,4 +237,15 @@ TEST_CASE("graspsim compare --help explains tolerances, exit codes and h5diff", 
   for (const char* s : {"--atol", "--rtol", "--tol PATTERN=ATOL", "--bitwise", "--json", "--attributes",
                         "exit status", "h5diff", "servo/*"})
     CHECK_THAT(o.output, Catch::Contains(s));
+}
+
+// The one JSON escaper (app/json.hpp), which compare's --json and the view's scene both use:
+// quotes and backslashes escaped, control bytes as \n \r \t or \u00XX, the rest as it is.
+TEST_CASE("the JSON escaper escapes what RFC 8259 requires and keeps the rest", "[compare_cli][json]") {
+  CHECK(graspsim::app::json_string("") == "\"\"");
+  CHECK(graspsim::app::json_string("box \"a\" \\ b") == "\"box \\\"a\\\" \\\\ b\"");
+  CHECK(graspsim::app::json_string("l1\nl2\r\t") == "\"l1\\nl2\\r\\t\"");
+  CHECK(graspsim::app::json_string(std::string("\x01\x1f\x7f", 3)) == "\"\\u0001\\u001f\x7f\"");
+  CHECK(graspsim::app::json_string("caf\xc3\xa9") == "\"caf\xc3\xa9\"");
+  CHECK(JsonChecker(graspsim::app::json_string(std::string("\0\b\f/x", 5))).valid());
 }
