@@ -132,7 +132,9 @@ constexpr const char* kHelp =
     "and renamed to FILE.h5 when the run ends, complete or marked: an earlier FILE.h5 is replaced\n"
     "only then. A run that stops early keeps its trace, with root attribute status = \"error: ...\";\n"
     "a device that cannot be opened at the start writes nothing. The output may not be an input\n"
-    "(the scenario, a mesh file, a replay recording), nor a link to one.\n"
+    "(the scenario, a mesh file, a replay recording), nor a link to one, nor anything but a\n"
+    "regular file (a device such as /dev/null, a FIFO, a socket, a directory): --no-trace\n"
+    "writes no trace.\n"
     "A run killed outright leaves FILE.h5.partial, status \"running\", with every tick up to\n"
     "its last flush but one (less than 0.25 s of simulated time lost): h5py opens it with\n"
     "swmr=True; after `graspsim repair FILE.h5.partial` (see `graspsim repair --help`) every\n"
@@ -366,6 +368,14 @@ int run_command(const std::vector<std::string>& args) {
   if (no_trace && (record || out_given || compress_given))
     return bad_input(std::string("--no-trace writes no trace, so it takes no ") +
                      (record ? "--record" : out_given ? "--out" : "--compress"));
+  // Only a regular file is replaced: a device, FIFO, socket or directory at an output path is
+  // refused before anything runs (the run's claim on its trace checks it again).
+  try {
+    if (out_given) graspsim::app::refuse_unreplaceable(out, {});
+    if (!summary.empty()) graspsim::app::refuse_unreplaceable(summary, {"--summary", "leave out --summary to write none"});
+  } catch (const graspsim::app::OutputError& e) {
+    return bad_input(e.what());
+  }
 
   std::optional<graspsim::scripting::Scenario> scenario;
   try {

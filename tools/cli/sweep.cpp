@@ -17,6 +17,7 @@
 #include <thread>
 #include <unistd.h>
 
+#include "app/output_file.hpp"
 #include "app/sweep_exec.hpp"
 #include "app/sweep_table.hpp"
 #include "cli/report.hpp"
@@ -134,16 +135,31 @@ struct Progress {
   }
 };
 
+// DIR/sweep.png, drawn into DIR/sweep.partial.png (matplotlib takes the format from the name)
+// and renamed over it: a link at sweep.png is replaced, never written through.
 void plot(const std::string& dir) {
+  const std::string png = (fs::path(dir) / "sweep.png").string();
+  const std::string partial = (fs::path(dir) / "sweep.partial.png").string();
+  for (const std::string& path : {png, partial}) {
+    if (const std::string what = app::not_replaceable(path); !what.empty()) {
+      std::cerr << "graspsim sweep: warning: no plot: " << path << " is " << what << ", not a file; the table is written\n";
+      return;
+    }
+  }
   const std::string script = GRASPSIM_PLOT_SWEEP;
   // Debian's python3 (python3-matplotlib, tools/setup.sh), not one earlier on PATH without it.
   const std::string python = fs::exists("/usr/bin/python3") ? "/usr/bin/python3" : "python3";
   const std::string command = python + " " + shell_quote(script) + " " +
-                              shell_quote((fs::path(dir) / "sweep.csv").string()) + " --out " +
-                              shell_quote((fs::path(dir) / "sweep.png").string());
-  if (!fs::exists(script) || std::system(command.c_str()) != 0)
+                              shell_quote((fs::path(dir) / "sweep.csv").string()) + " --out " + shell_quote(partial);
+  std::error_code ec;
+  if (!fs::exists(script) || std::system(command.c_str()) != 0) {
+    fs::remove(partial, ec);
     std::cerr << "graspsim sweep: warning: no plot (" << command
               << " failed: it needs python3-matplotlib); the table is written\n";
+    return;
+  }
+  fs::rename(partial, png, ec);
+  if (ec) std::cerr << "graspsim sweep: warning: cannot rename " << partial << " to " << png << ": " << ec.message() << "\n";
 }
 
 }  // namespace
@@ -217,6 +233,18 @@ int sweep_command(const std::vector<std::string>& args) {
   const std::string dir = fs::absolute(out).lexically_normal().string();
   const std::string plan_file = (fs::path(dir) / "sweep.plan").string();
   std::error_code ec;
+  if (fs::exists(fs::status(dir, ec)) && !fs::is_directory(dir, ec))
+    return bad_input("--out " + out + " is " + app::not_replaceable(dir) + ", not a folder: a sweep writes its table "
+                     "and its runs into a folder; choose a new or empty one");
+  // The sweep's own files are replaced only when they are files (a device, a FIFO or a socket
+  // left there is refused before anything runs).
+  for (const char* name : {"sweep.plan", "sweep.plan.partial", "sweep.csv", "sweep.h5", "sweep.png"}) {
+    try {
+      check_replaceable((fs::path(dir) / name).string());
+    } catch (const SweepError& e) {
+      return bad_input("--out " + out + ": " + e.what());
+    }
+  }
   if (fs::is_directory(dir, ec) && !fs::exists(plan_file, ec)) {
     for (const auto& entry : fs::directory_iterator(dir, ec)) {
       const bool empty_runs = entry.path().filename() == "runs" && fs::is_directory(entry.path(), ec) &&
