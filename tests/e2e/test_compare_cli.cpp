@@ -14,6 +14,7 @@
 
 #include "app/json.hpp"
 #include "tests/support/shell.hpp"
+#include "tests/support/skip.hpp"
 #include "tests/support/trace_edit.hpp"
 
 namespace {
@@ -237,6 +238,46 @@ TEST_CASE("graspsim compare --help explains tolerances, exit codes and h5diff", 
   for (const char* s : {"--atol", "--rtol", "--tol PATTERN=ATOL", "--bitwise", "--json", "--attributes",
                         "exit status", "h5diff", "servo/*"})
     CHECK_THAT(o.output, Catch::Contains(s));
+}
+
+// Two files whose /physics is missing, or a scalar dataset where the table should be, are not
+// "the same": compare_traces compares the tables both hold (here /servo and /haptic, equal) and
+// passes over the rest, so without a check they compared equal, exit 0. Each trace's root
+// attribute `record` names physics, so a table with a tick column must be there: exit 2, naming
+// the file and what is wrong. A trace that did not --record physics still compares (exit 0).
+TEST_CASE("graspsim compare refuses traces whose /physics is missing or a scalar", "[compare_cli][bad_input]") {
+  if (graspsim::test::shell("/usr/bin/python3 -c 'import h5py'").status != 0)
+    GRASPSIM_SKIP("no python3-h5py to edit the traces with");
+  const std::string a = kTmp + "/compare_cli_physics_a.h5";
+  run_lift(a);
+  const auto edited = [&](const std::string& name, const std::string& edit) {
+    const std::string path = kTmp + "/compare_cli_physics_" + name + ".h5";
+    std::filesystem::remove(path);
+    std::filesystem::copy_file(a, path);
+    const Outcome o = graspsim::test::shell("/usr/bin/python3 -c \"import h5py, sys; f = h5py.File(sys.argv[1], 'a'); " +
+                                            edit + "\" " + path);
+    INFO(o.output);
+    REQUIRE(o.status == 0);
+    return path;
+  };
+  const std::string missing = edited("missing", "del f['physics']");
+  const std::string scalar = edited("scalar", "del f['physics']; f['physics'] = 0.0");
+  struct Case {
+    std::string a, b, says;
+  };
+  for (const Case& c : {Case{missing, missing, "/physics is missing"}, Case{scalar, scalar, "/physics is a plain dataset"},
+                        Case{a, missing, "/physics is missing"}, Case{scalar, a, "/physics is a plain dataset"}}) {
+    for (const std::string json : {"", " --json"}) {
+      const Outcome o = cli("compare " + c.a + " " + c.b + json);
+      INFO("compare " << c.a << " " << c.b << json << "\n" << o.output);
+      CHECK(o.status == 2);
+      CHECK_THAT(o.output, Catch::Contains("is not a whole graspsim trace: " + c.says) &&
+                               Catch::Contains("its root attribute record is 'servo:1,haptic:1,physics:1,devices:1'"));
+    }
+  }
+  const std::string servo_only = kTmp + "/compare_cli_servo_only.h5";
+  run_lift(servo_only, "--record servo,haptic");
+  CHECK(cli("compare " + servo_only + " " + servo_only).status == 0);
 }
 
 // The one JSON escaper (app/json.hpp), which compare's --json and the view's scene both use:

@@ -214,7 +214,8 @@ constexpr const char* kCompareHelp =
     "not count; ticks in one trace only count only with --all-ticks, root attributes only with\n"
     "--attributes); 1 different: some element outside the tolerance (or a counted tick or\n"
     "attribute); 2 unusable input: a missing, truncated or non-HDF5 file, not a graspsim trace,\n"
-    "schema versions or rates that differ, no loop both traces hold, a column of a shared loop\n"
+    "schema versions or rates that differ, no loop both traces hold, a loop a trace records\n"
+    "missing or not a table (a /physics that is absent or a scalar), a column of a shared loop\n"
     "in one trace only, different shapes, bad options (an --only loop neither trace holds).\n"
     "\n"
     "Why not h5diff: with the box's height changed by 1e-9 m at one physics tick of the\n"
@@ -619,6 +620,9 @@ int compare_command(const std::vector<std::string>& args) {
   rec::CompareResult result;
   try {
     result = rec::compare_traces(files[0], files[1], options);
+    // Loops a trace records that are no table of it are never "the same": refused.
+    for (const std::string& f : files)
+      if (const std::string missing = graspsim::app::missing_loop_tables(f); !missing.empty()) return input_error(missing);
   } catch (const rec::TraceError& e) {
     return input_error(e.what());
   }
