@@ -9,10 +9,14 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <chrono>
+#include <csignal>
 #include <string>
 #include <sys/wait.h>
+#include <thread>
 
 #include "app/json.hpp"
+#include "tests/support/process.hpp"
 #include "tests/support/shell.hpp"
 #include "tests/support/skip.hpp"
 #include "tests/support/trace_edit.hpp"
@@ -278,6 +282,27 @@ TEST_CASE("graspsim compare refuses traces whose /physics is missing or a scalar
   const std::string servo_only = kTmp + "/compare_cli_servo_only.h5";
   run_lift(servo_only, "--record servo,haptic");
   CHECK(cli("compare " + servo_only + " " + servo_only).status == 0);
+}
+
+// compare --view serves the page where --port says, as `graspsim view` does (0: any free port,
+// printed); stopped by SIGINT it exits 0.
+TEST_CASE("graspsim compare --view takes --port", "[compare_cli][view]") {
+  const std::string a = kTmp + "/compare_cli_view.h5";
+  run_lift(a);
+  const std::string log = kTmp + "/compare_cli_view.log";
+  graspsim::test::Child child({kCli, "compare", a, a, "--view", "--port", "0"}, log);
+  std::string printed;
+  for (int i = 0; i < 6000 && child.running(); ++i) {   // until it prints its URL (at most 60 s)
+    printed = graspsim::test::file_bytes(log).value_or("");
+    if (printed.find("url  http://127.0.0.1:") != std::string::npos) break;
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  INFO(printed);
+  REQUIRE_THAT(printed, Catch::Contains("SAME") && Catch::Contains("url  http://127.0.0.1:"));
+  CHECK_THAT(printed, !Catch::Contains("http://127.0.0.1:8717/"));   // not the default: any free port
+  REQUIRE(kill(child.pid(), SIGINT) == 0);
+  const graspsim::test::Ended e = child.wait();
+  CHECK(e.status == 0);
 }
 
 // The one JSON escaper (app/json.hpp), which compare's --json and the view's scene both use:
