@@ -30,6 +30,22 @@ TEST_CASE("graspsim --help explains the command and exits 0", "[cli]") {
   CHECK(cli("run --help").status == 0);
 }
 
+// A rehearsal's own stall and lag limits (--pace with simulated devices) are refused with a hand
+// on a real device, before any device opens: such a device is released after 20 ms without a
+// fresh force whatever the machine.
+TEST_CASE("a rehearsal's --stall-timeout and --lag-limit are refused with a real device", "[cli][bad_input][pacing]") {
+  const std::string lift = std::string(GRASPSIM_SOURCE_DIR) + "/scenarios/two_finger_lift.lua";
+  for (const std::string option : {"--stall-timeout 1", "--lag-limit 1"}) {
+    const Outcome o = cli("run " + lift + " --pace " + option + " --device thumb=udp:127.0.0.1:9 --out " + kTmp +
+                          "/cli_limits.h5");
+    INFO(o.output);
+    CHECK(o.status == 2);
+    CHECK_THAT(o.output, Catch::Contains(option.substr(0, option.find(' ')) +
+                                         " is for a rehearsal (--pace with simulated devices)"));
+    CHECK_THAT(o.output, !Catch::Contains("pacing"));
+  }
+}
+
 // Each bad input ends with exit status 2 and a message that names the problem: the file and
 // line for Lua errors, the field for bad values.
 TEST_CASE("bad input gives exit status 2 and names the problem", "[cli][bad_input]") {
@@ -84,7 +100,10 @@ TEST_CASE("each subcommand refuses bad arguments with exit 2, naming them, and s
         {"run " + lift + " " + lift, "one scenario at a time"},
         {"run " + lift + " --port 70000 --view", "--port needs a port number from 0 to 65535 (got '70000')"},
         {"run " + lift + " --compress 10", "--compress needs a level from 1 to 9 (got '10')"},
-        {"run " + lift + " --summary", "--summary needs a file name"}}},
+        {"run " + lift + " --summary", "--summary needs a file name"},
+        {"run " + lift + " --stall-timeout 1", "--stall-timeout is a limit of a rehearsal: it needs --pace"},
+        {"run " + lift + " --pace --lag-limit 0", "--lag-limit needs a time in s, more than 0 and at most 86400"},
+        {"run " + lift + " --no-trace --out x.h5", "--no-trace writes no trace, so it takes no --out"}}},
       {"sweep",
        {{"sweep " + lift + " --grid mu=0.5 --out x --bogus", "unknown option '--bogus'"},
         {"sweep --grid mu=0.5 --out x", "sweep needs a scenario file"},

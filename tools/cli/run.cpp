@@ -33,7 +33,8 @@ namespace {
 constexpr const char* kRunUsage =
     "usage: graspsim run SCENARIO.lua [--out FILE.h5] [--duration S] [--set NAME=VALUE]...\n"
     "                [--device FINGER=SPEC]... [--jitter A [--jitter-seed N]] [--refuse-unstable]\n"
-    "                [--no-trace | --record LOOP[:EVERY],...] [--compress N] [--summary FILE] [--pace]\n"
+    "                [--no-trace | --record LOOP[:EVERY],...] [--compress N] [--summary FILE]\n"
+    "                [--pace [--stall-timeout S] [--lag-limit S]]\n"
     "                [--view [--port N] [--open] | --no-view] [--quiet]\n";
 
 constexpr const char* kHelp =
@@ -85,6 +86,11 @@ constexpr const char* kHelp =
     "  --pace               pace the run in real time at the servo rate, as a udp or phantom\n"
     "                       device does, with simulated devices too (a rehearsal of a session:\n"
     "                       the same deadlines, stall and lag limits and overrun counts)\n"
+    "  --stall-timeout S    a rehearsal's stall limit instead of 0.02 s (with --pace and\n"
+    "                       simulated devices only: a hand on a real device is always released\n"
+    "                       after 20 ms without a fresh force); for a machine that cannot keep\n"
+    "                       20 ms (a loaded VM), so that the rehearsal runs on and counts its gaps\n"
+    "  --lag-limit S        the same for the lag limit, instead of 0.1 s\n"
     "  --view               serve a live 3D view of the run on 127.0.0.1 while it goes (the\n"
     "                       page of `graspsim view`, fed about 60 times a second; the run never\n"
     "                       waits for it, the trace is the same); prints its URL. On by default\n"
@@ -150,6 +156,7 @@ struct RunArgs {
   scripting::LoadOptions load;
   long long compression = 0;
   bool quiet = false, refuse_unstable = false, no_trace = false, pace = false;
+  double stall_timeout = 0.0, lag_limit = 0.0;   // s: a rehearsal's own limits (0: the defaults)
   bool jitter_seed_given = false, record_given = false;
   std::optional<recordings::RecordSelection> record;
   std::vector<std::string> devices;   // --device FINGER=SPEC
@@ -203,6 +210,10 @@ CommandLine run_line(RunArgs& a) {
   line.options.push_back(record_option(a));
   line.options.push_back(flag("--refuse-unstable", a.refuse_unstable));
   line.options.push_back(flag("--pace", a.pace));
+  // Up to a day (a run's longest duration): the pacer holds them in integer ns.
+  const auto limit = [](double s) { return s > 0.0 && s <= 86400.0; };
+  line.options.push_back(number("--stall-timeout", "a time in s, more than 0 and at most 86400", a.stall_timeout, limit));
+  line.options.push_back(number("--lag-limit", "a time in s, more than 0 and at most 86400", a.lag_limit, limit));
   line.options.push_back(flag("--quiet", a.quiet));
   line.options.push_back(text("--summary", "a file name", a.summary));
   for (Option& o : live_options(a.live)) line.options.push_back(std::move(o));
@@ -214,14 +225,21 @@ CommandLine run_line(RunArgs& a) {
   return line;
 }
 
-// What the command line may not ask for together, and the output paths, checked before anything
-// is loaded or written: "" when fine.
-std::string check_arguments(const RunArgs& a) {
+// What the command line may not ask for together: "" when fine.
+std::string check_combinations(const RunArgs& a) {
+  if ((a.stall_timeout > 0.0 || a.lag_limit > 0.0) && !a.pace)
+    return std::string(a.stall_timeout > 0.0 ? "--stall-timeout" : "--lag-limit") +
+           " is a limit of a rehearsal: it needs --pace";
   if (a.jitter_seed_given && !(a.load.jitter.amplitude > 0.0))
     return "--jitter-seed needs --jitter A with A > 0 (without an amplitude nothing is drawn)";
   if (a.no_trace && (a.record || !a.out.empty() || a.compression != 0))
     return std::string("--no-trace writes no trace, so it takes no ") +
            (a.record ? "--record" : !a.out.empty() ? "--out" : "--compress");
+  return "";
+}
+
+// The output paths, checked before anything is loaded or written: "" when fine.
+std::string check_outputs(const RunArgs& a) {
   // Only a regular file is replaced: a device, FIFO, socket or directory at an output path is
   // refused before anything runs (the run's claim on its trace checks it again).
   try {
@@ -384,7 +402,13 @@ int run_checked(const RunArgs& a) {
   app::SteadyClock steady;
   std::optional<app::Pacer> pacer;
   if (plan.any_real() || a.pace) {
-    pacer.emplace(steady, scenario->model().rates.servo, app::kStallTimeout);
+    // A rehearsal's own limits; never with a hand on a real device.
+    if (plan.any_real() && (a.stall_timeout > 0.0 || a.lag_limit > 0.0))
+      return bad_input(std::string(a.stall_timeout > 0.0 ? "--stall-timeout" : "--lag-limit") +
+                       " is for a rehearsal (--pace with simulated devices): a device with a hand on it is released "
+                       "after 20 ms without a fresh force, and when the loop falls 100 ms behind");
+    pacer.emplace(steady, scenario->model().rates.servo, a.stall_timeout > 0.0 ? a.stall_timeout : app::kStallTimeout,
+                  a.lag_limit > 0.0 ? a.lag_limit : app::kLagLimit);
     options.pacing.pacer = &*pacer;
     const std::string why = app::probe_realtime();
     options.pacing.realtime = why.empty();
@@ -437,7 +461,8 @@ int run_command(const std::vector<std::string>& args) {
     case Parsed::kGo: break;
   }
   if (a.scenario.empty()) return usage_error(line, "run needs a scenario file");
-  if (const std::string e = check_arguments(a); !e.empty()) return bad_input(e);
+  if (const std::string e = check_combinations(a); !e.empty()) return usage_error(line, e);
+  if (const std::string e = check_outputs(a); !e.empty()) return bad_input(e);
   return run_checked(a);
 }
 
