@@ -347,19 +347,35 @@ int sweep_command(const std::vector<std::string>& args) {
 }
 
 int sweep_task_command(const std::vector<std::string>& args) {
-  std::uint64_t index = 0;
-  if (args.size() != 2 || args[1].empty() || args[1].find_first_not_of("0123456789") != std::string::npos)
-    return bad_input("usage: graspsim sweep-task DIR INDEX (a Slurm array task of graspsim sweep --slurm)");
-  index = std::strtoull(args[1].c_str(), nullptr, 10);
-  const std::string dir = args[0], plan_file = (fs::path(dir) / "sweep.plan").string();
+  std::vector<std::string> operands;
+  constexpr const char* kTaskUsage = "usage: graspsim sweep-task DIR INDEX\n";
+  const CommandLine line{"sweep-task", kTaskUsage,
+                         std::string(kTaskUsage) + "\nRuns run INDEX of the sweep in DIR and writes its row: a Slurm "
+                                                  "array task of `graspsim sweep --slurm`, which submits it.\n",
+                         {},
+                         [&operands](const std::string& v) {
+                           operands.push_back(v);
+                           return std::string();
+                         }};
+  switch (parse_command_line(line, args)) {
+    case Parsed::kHelp: return kExitOk;
+    case Parsed::kError: return kExitBadInput;
+    case Parsed::kGo: break;
+  }
+  if (operands.size() != 2 || operands[1].empty() || operands[1].size() > 18 ||
+      operands[1].find_first_not_of("0123456789") != std::string::npos)
+    return usage_error(line, "sweep-task needs a sweep's folder and a run's number");
+  const std::string& number = operands[1];
+  const std::uint64_t index = std::strtoull(number.c_str(), nullptr, 10);
+  const std::string dir = operands[0], plan_file = (fs::path(dir) / "sweep.plan").string();
   try {
     const Plan plan = Plan::parse(read_file(plan_file), plan_file);
-    if (index >= plan.size()) return bad_input(plan_file + " has " + std::to_string(plan.size()) + " runs, not run " + args[1]);
+    if (index >= plan.size()) return bad_input(plan_file + " has " + std::to_string(plan.size()) + " runs, not run " + number);
     const auto start = std::chrono::steady_clock::now();
     const pid_t pid = start_run(self_program(), plan, dir, index);
     int status = 0;
     while (waitpid(pid, &status, 0) < 0)
-      if (errno != EINTR) return bad_input("cannot wait for run " + args[1]);
+      if (errno != EINTR) return bad_input("cannot wait for run " + number);
     const Row row = finish_run(plan, dir, index, status,
                                std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
     return row.exit_status < 128 ? kExitOk : row.exit_status;
