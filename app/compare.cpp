@@ -1,9 +1,15 @@
 // `graspsim compare` output: table and JSON.
 #include "app/compare.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <optional>
 #include <sstream>
+
+#include "app/json.hpp"
+#include "graspsim/recordings/record_selection.hpp"
+#include "graspsim/recordings/trace_reader.hpp"
 
 namespace graspsim::app {
 namespace {
@@ -69,28 +75,6 @@ std::string tolerance_text(const recordings::Tolerance& t) {
 
 // --- JSON ------------------------------------------------------------------------------------
 
-std::string json_string(const std::string& s) {
-  std::string out = "\"";
-  for (const unsigned char c : s) {
-    switch (c) {
-      case '"': out += "\\\""; break;
-      case '\\': out += "\\\\"; break;
-      case '\n': out += "\\n"; break;
-      case '\r': out += "\\r"; break;
-      case '\t': out += "\\t"; break;
-      default:
-        if (c < 0x20) {
-          char buf[8];
-          std::snprintf(buf, sizeof buf, "\\u%04x", c);
-          out += buf;
-        } else {
-          out += static_cast<char>(c);
-        }
-    }
-  }
-  return out + "\"";
-}
-
 // Finite numbers exactly (%.17g); inf, -inf and nan as the strings "inf", "-inf", "nan".
 std::string json_number(double x) {
   if (std::isnan(x)) return "\"nan\"";
@@ -108,6 +92,29 @@ std::string json_point(const std::optional<ElementPoint>& p, const DatasetResult
 }
 
 }  // namespace
+
+std::string missing_loop_tables(const std::string& trace) {
+  const std::optional<std::string> attribute =
+      recordings::has_attribute(trace, "/", "record")
+          ? std::optional<std::string>(recordings::read_string_attribute(trace, "/", "record"))
+          : std::nullopt;
+  const recordings::RecordSelection record = recordings::RecordSelection::from_attribute(attribute);
+  const std::vector<std::string> datasets = recordings::list_datasets(trace);
+  const auto holds = [&](const std::string& path) { return std::binary_search(datasets.begin(), datasets.end(), path); };
+  std::string missing;
+  for (const auto loop : {recordings::RecordedLoop::kServo, recordings::RecordedLoop::kHaptic,
+                          recordings::RecordedLoop::kPhysics}) {
+    if (!record.records(loop)) continue;
+    const std::string name(recordings::kRecordedLoopNames[static_cast<std::size_t>(loop)]);
+    if (holds("/" + name + "/tick")) continue;
+    missing += (missing.empty() ? "" : "; ") + std::string("/") + name +
+               (holds("/" + name) ? " is a plain dataset, not a table of ticks" : " is missing");
+  }
+  if (missing.empty()) return "";
+  return "'" + trace + "' is not a whole graspsim trace: " + missing + " (" +
+         (attribute ? "its root attribute record is '" + *attribute + "'" : std::string("it has no root attribute record: every loop")) +
+         ", and a run writes each loop it records as a table with a tick column)";
+}
 
 std::string compare_table(const CompareResult& r, bool all) {
   std::ostringstream o;

@@ -29,7 +29,34 @@ bool same_path(const std::string& a, const std::string& b) {
 
 std::string in_quotes(const std::string& text) { return "'" + text + "'"; }
 
+const char* kind_of(mode_t mode) {
+  if (S_ISDIR(mode)) return "a directory";
+  if (S_ISCHR(mode)) return "a character device";
+  if (S_ISBLK(mode)) return "a block device";
+  if (S_ISFIFO(mode)) return "a FIFO";
+  if (S_ISSOCK(mode)) return "a socket";
+  return "not a regular file";
+}
+
 }  // namespace
+
+std::string not_replaceable(const std::string& path) {
+  struct stat target{};
+  if (stat(path.c_str(), &target) != 0 || S_ISREG(target.st_mode)) return "";   // nothing there, or a file
+  struct stat link{};
+  const bool linked = lstat(path.c_str(), &link) == 0 && S_ISLNK(link.st_mode);
+  return std::string(linked ? "a symbolic link to " : "") + kind_of(target.st_mode);
+}
+
+void refuse_unreplaceable(const std::string& path, const OutputNaming& naming) {
+  const std::string what = not_replaceable(path);
+  if (what.empty()) return;
+  const bool directory = what.ends_with("a directory");
+  throw OutputError(naming.option + " " + in_quotes(path) + " is " + what +
+                    ", not a regular file: graspsim replaces only regular files (it writes beside the path and "
+                    "renames over it, which would put a file in place of " + (directory ? "the directory" : "it") +
+                    "); " + (directory ? "name a file in it, or " : "") + naming.write_none);
+}
 
 std::string default_trace_name(const std::string& scenario_name) {
   const std::string name = scenario_name.substr(0, kMaxStem);
@@ -76,10 +103,16 @@ bool locked_by_a_run(const std::string& path) {
   return locked;
 }
 
-OutputClaim::OutputClaim(const std::string& out) : out_(out), partial_(partial_name(out)) {
-  struct stat st{};
-  if (stat(out.c_str(), &st) == 0 && S_ISDIR(st.st_mode))
-    throw OutputError("--out " + in_quotes(out) + " is a directory: name a file in it");
+OutputClaim::OutputClaim(const std::string& out, const OutputNaming& naming)
+    : out_(out), partial_(partial_name(out)), naming_(naming) {
+  refuse_unreplaceable(out, naming);
+  // The partial is created, or an empty one of a run that ended reused: never anything else.
+  struct stat there{};
+  if (lstat(partial_.c_str(), &there) == 0 && !S_ISREG(there.st_mode)) {
+    throw OutputError(naming.option + " " + in_quotes(out) + " is written as " + in_quotes(partial_) +
+                      " until the run ends, and that name is taken by " +
+                      (S_ISLNK(there.st_mode) ? "a symbolic link" : kind_of(there.st_mode)) + ": move it away");
+  }
   // A few rounds at most: a round is lost only when a run that held the partial renamed it away
   // between our open and our lock.
   for (int round = 0; round < 8; ++round) {
@@ -87,10 +120,16 @@ OutputClaim::OutputClaim(const std::string& out) : out_(out), partial_(partial_n
     const bool created = fd >= 0;
     if (!created) {
       if (errno != EEXIST) throw OutputError("cannot create the trace " + in_quotes(partial_) + ": " + std::strerror(errno));
-      fd = open(partial_.c_str(), O_RDWR | O_CLOEXEC);   // no O_CREAT, no O_TRUNC: changes nothing
+      // No O_CREAT, no O_TRUNC: changes nothing. Not through a link, and never a FIFO's wait.
+      fd = open(partial_.c_str(), O_RDWR | O_CLOEXEC | O_NOFOLLOW | O_NONBLOCK);
       if (fd < 0) {
         if (errno == ENOENT) continue;
         throw OutputError("cannot open " + in_quotes(partial_) + ": " + std::strerror(errno));
+      }
+      struct stat opened{};
+      if (fstat(fd, &opened) != 0 || !S_ISREG(opened.st_mode)) {
+        ::close(fd);
+        throw OutputError(in_quotes(partial_) + " is not a regular file: move it away to write " + in_quotes(out));
       }
     }
     struct flock lock{};
@@ -138,6 +177,10 @@ bool OutputClaim::still_ours() const {
 
 void OutputClaim::commit() {
   if (done_) return;
+  if (const std::string what = not_replaceable(out_); !what.empty()) {
+    throw OutputError(in_quotes(out_) + " became " + what + " while the run wrote its trace, and is not replaced: "
+                      "the trace is kept under its partial name");
+  }
   if (std::rename(partial_.c_str(), out_.c_str()) != 0) {
     throw OutputError("cannot rename the finished trace " + in_quotes(partial_) + " to " + in_quotes(out_) + ": " +
                       std::strerror(errno) + " (the trace is kept under its partial name)");

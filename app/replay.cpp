@@ -387,6 +387,8 @@ RunOptions ReplayPlan::run_options(const std::string& out) const {
   options.overrides = overrides;
   options.stop.max_ticks = recorded_ticks;
   options.trace.record = record;
+  // A replay always writes its trace: it is what is compared with the recording.
+  options.trace.naming.write_none = "a replay writes its trace to compare it with the recording: name a file with --out";
   options.attributes.emplace_back("replay_of", replay_of());
   options.inputs.push_back({trace, "the trace replayed"});
   for (const RecordedFinger& r : fingers) {

@@ -45,6 +45,9 @@ struct RunOptions {
     // The loops written and how often (--record; root attribute `record`): default every loop
     // at every tick. Replay needs /servo (and /devices, where a device was recorded) at every tick.
     recordings::RecordSelection record;
+    // How messages name the output and say how to write none: `--out` and `--no-trace` for the
+    // CLI's run; a replay or the Python module say their own.
+    OutputNaming naming;
   } trace;
 
   // What drives each finger, and what of it is recorded (README.md "Devices").

@@ -67,8 +67,8 @@ RunTrace::RunTrace(const scripting::Scenario& scenario, const RunOptions& option
   }
   try {
     if (options.trace.write) {
-      refuse_input_as_output(path_, run_inputs(scenario, options));   // throws OutputError
-      claim_.emplace(path_);                   // throws OutputError
+      refuse_input_as_output(path_, run_inputs(scenario, options), options.trace.naming.option);   // throws OutputError
+      claim_.emplace(path_, options.trace.naming);                 // throws OutputError
       recordings::TraceOptions trace_options;
       if (options.trace.block_rows > 0) trace_options.block_rows = options.trace.block_rows;
       trace_options.compression = options.trace.compression;

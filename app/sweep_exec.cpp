@@ -2,6 +2,7 @@
 #include "app/sweep_exec.hpp"
 
 #include "app/output_file.hpp"
+#include "app/sweep_row.hpp"
 
 #include <cerrno>
 #include <chrono>
@@ -33,6 +34,7 @@ pid_t start_run(const std::string& program, const Plan& plan, const std::string&
   for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
   argv.push_back(nullptr);
   const std::string log = plan.run_file(dir, index, "log");
+  for (const char* extension : {"log", "summary", "row"}) check_replaceable(plan.run_file(dir, index, extension));
   std::remove(plan.run_file(dir, index, "summary").c_str());   // a stopped run's, if any
   std::remove((plan.run_file(dir, index, "summary") + ".partial").c_str());   // a killed run's, if any
   if (plan.keep_traces) clear_stale_partial(plan, dir, index);

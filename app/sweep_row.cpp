@@ -7,12 +7,17 @@
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
+
+#include "app/output_file.hpp"
 #include <sstream>
 
 namespace graspsim::app::sweep {
 
 std::string read_file(const std::string& path) {
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec)) return {};   // a FIFO's read would wait for a writer
   std::ifstream in(path, std::ios::binary);
   std::ostringstream text;
   text << in.rdbuf();
@@ -81,6 +86,8 @@ Row parse_row(const std::string& text, const std::string& file) {
 
 void write_row(const Plan& plan, const std::string& dir, const Row& row) {
   const std::string path = plan.run_file(dir, row.index, "row"), partial = path + ".partial";
+  check_replaceable(path);
+  check_replaceable(partial);
   {
     std::ofstream out(partial, std::ios::binary | std::ios::trunc);
     out << row_text(row);
@@ -105,8 +112,15 @@ std::optional<Row> read_row(const Plan& plan, const std::string& dir, std::size_
   return row;
 }
 
+void check_replaceable(const std::string& path) {
+  if (const std::string what = not_replaceable(path); !what.empty())
+    throw SweepError(path + " is " + what + ", not a regular file: a sweep replaces only files; move it away");
+}
+
 std::string write_summary(const std::string& path, const std::string& text) {
   const std::string partial = path + ".partial";
+  if (const std::string what = not_replaceable(path); !what.empty())
+    return "cannot write " + path + ": it is " + what + ", not a regular file (only a file is replaced)";
   const int fd = open(partial.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
   if (fd < 0) {
     const int e = errno;
@@ -125,6 +139,10 @@ std::string write_summary(const std::string& path, const std::string& text) {
     at += static_cast<std::size_t>(n);
   }
   if (close(fd) != 0 && !error) error = errno;
+  if (const std::string what = not_replaceable(path); !error && !what.empty()) {   // taken while it was written
+    unlink(partial.c_str());
+    return "cannot write " + path + ": it became " + what + ", not a regular file (only a file is replaced)";
+  }
   if (!error && std::rename(partial.c_str(), path.c_str()) != 0) error = errno;
   if (!error) return "";
   unlink(partial.c_str());

@@ -47,6 +47,10 @@ void write_row(const Plan& plan, const std::string& dir, const Row& row);
 // The run's row, if its file exists and belongs to this plan's run (same index, values and seed).
 std::optional<Row> read_row(const Plan& plan, const std::string& dir, std::size_t index);
 
-std::string read_file(const std::string& path);   // "" when it cannot be read
+std::string read_file(const std::string& path);   // "" when it cannot be read or is no regular file
+
+// Throws SweepError when something other than a regular file is at `path` (a directory, a
+// device, a FIFO, a socket: output_file.hpp, not_replaceable): a sweep replaces only files.
+void check_replaceable(const std::string& path);
 
 }  // namespace graspsim::app::sweep

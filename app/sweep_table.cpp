@@ -127,6 +127,8 @@ std::string csv_text(const std::vector<SweepColumn>& columns) {
 void write_table(const Plan& plan, const std::string& dir, const std::vector<Row>& rows) {
   const auto columns = table_columns(plan, rows);
   const std::string csv = (std::filesystem::path(dir) / "sweep.csv").string(), partial = csv + ".partial";
+  const std::string h5 = (std::filesystem::path(dir) / "sweep.h5").string();
+  for (const std::string& path : {csv, partial, h5, h5 + ".partial"}) check_replaceable(path);
   {
     std::ofstream out(partial, std::ios::binary | std::ios::trunc);
     out << csv_text(columns);
@@ -139,7 +141,7 @@ void write_table(const Plan& plan, const std::string& dir, const std::vector<Row
     if (!grid.empty()) grid += ' ';
     grid += a.name;
   }
-  recordings::write_sweep_table((std::filesystem::path(dir) / "sweep.h5").string(), columns,
+  recordings::write_sweep_table(h5, columns,
                                 {{"scenario", plan.scenario}, {"grid", grid},
                                  {"seeds", std::to_string(plan.seeds)}, {"plan", plan.text()}});
 }

@@ -7,10 +7,13 @@
 -- the period in closed form (Landau & Lifshitz, section 37): T = 4 K(k) / w_p, K the complete
 -- elliptic integral (computed below by the arithmetic-geometric mean), here T = 6.859 s; the y axis
 -- points against L half a period after the start and along it again one period after.
--- Energy and world angular momentum are conserved exactly; the implicit gyroscopic term never adds
--- energy (dt |w| = 0.02 <= J_min / (2 J_max) = 1/6) and loses some (6.6% in 10 s at 250 Hz, 1.7%
--- at 1 kHz: first order). With the paper's gyroscopic = "neglect" the body spins on about y and
--- never flips (--set gyroscopic=neglect: the flip expectations fail).
+-- Energy and world angular momentum are conserved exactly. Under the implicit integrator (this
+-- scenario's) the gyroscopic term is the implicit midpoint step on the angular momentum, which keeps
+-- the energy and |L| to rounding (engine integrate.hpp, gyroscopic_change). Under the paper's
+-- integrator (--set integrator=paper, as its golden runs) the implicit gyroscopic term never adds
+-- energy (dt |w| = 0.02 <= J_min / (2 J_max) = 1/6) and loses some (6.6% in 10 s at 250 Hz, 1.7% at
+-- 1 kHz: first order). With the paper's gyroscopic = "neglect" the body spins on about y and never
+-- flips (--set gyroscopic=neglect: the flip expectations fail).
 
 local J = { 1.0, 2.0, 3.0 }      -- kg m^2
 local w0 = { 0.1, 5.0, 0.1 }     -- rad/s, body = world at the start
@@ -82,10 +85,13 @@ return {
         local c = y_along_L0(sim.objects.body)
         return c > 0.99, string.format("y . L/|L| = %.4f", c)
       end },
+    -- Beyond rounding: the midpoint step conserves E, each step rounding it by at most 32 eps
+    -- (tests/engine/test_free_spin.cpp): 1.8e-11 over these 2500 steps, 2.1e-10 over the 30000
+    -- of physics at 3 kHz (tests/e2e/test_scenarios.cpp runs both); held to 1e-9.
     { what = "the energy has not grown (implicit gyroscopic term)",
       check = function(sim)
         local e, e0 = energy(sim.objects.body), energy(sim.initial.objects.body)
-        return e <= e0, string.format("E / E0 = %.4f", e / e0)
+        return e <= e0 * (1 + 1e-9), string.format("E / E0 - 1 = %.2g", e / e0 - 1)
       end },
     { what = "the world angular momentum has drifted less than 6%",
       check = function(sim)

@@ -22,6 +22,8 @@ graspsim_packages=(
   clang libclang-rt-dev             # the Clang twin (tests/golden/test_compiler_twin.cpp), the
                                     # sanitizer build (its runtimes) and libFuzzer (README.md
                                     # "Sanitizers and fuzzing")
+  llvm                              # llvm-symbolizer, which the sanitizers' reports need to name
+                                    # functions and lines (Debian's clang does not bring it)
   libcpp-httplib-dev                # `graspsim view`'s HTTP server (view/README.md)
   pybind11-dev python3-dev python3-numpy python3-pytest
                                     # the Python module and its tests (python/README.md), for

@@ -56,6 +56,58 @@ Vec3 gyroscopic_implicit(const Vec3& inertia, const Vec3& w_b, double dt) {
   return -Jf.partialPivLu().solve(f);
 }
 
+// The torque-free part of Euler's equation over dt by the implicit midpoint rule on the body-frame
+// angular momentum L = Jp w_b (K = Jp^-1):
+//   L1 = L0 + dt M x K M,   M = (L0 + L1) / 2          (Euler: dL/dt = L x K L in the body frame)
+// It conserves both invariants of the free body, which are quadratic in L, exactly (the midpoint
+// rule keeps every quadratic invariant: Hairer, Lubich & Wanner, Geometric Numerical Integration,
+// IV.2): dotting M = L0 + dt/2 M x K M with M and with K M, whose cross terms vanish,
+//   M.M = M.L0    and    M.K M = L0.K M,
+// so with L1 = 2 M - L0
+//   |L1|^2 = 4 M.M - 4 M.L0 + |L0|^2 = |L0|^2,   L1.K L1 = 4 M.K M - 4 L0.K M + L0.K L0 = L0.K L0,
+// whatever dt and |w|: no energy is gained at any spin and rate (a first-order scheme cannot
+// promise that: forward Euler always gains, one Newton step of backward Euler only while
+// dt |w| <= Jmin / (2 Jmax)). Chosen over the exact motion: the exact asymmetric body needs
+// Jacobi's elliptic functions and an elliptic integral of the third kind per step; the midpoint
+// rule keeps the two invariants that decide whether a step gains energy, and is second order.
+//
+// M is found by Newton's method on F(M) = M - L0 - dt/2 M x K M, whose derivative is
+// I - dt/2 (S(M) K - S(K M)), from M = L0. Once an update is below 1e-9 |L0| one more is taken:
+// Newton's error squares at each update (times about dt |w| Jmax / Jmin), so the last one leaves
+// M at rounding. Newton converges from L0 while dt/2 |w| is about 1 or less (2 rad a step:
+// 100 rad/s at 50 Hz); a step whose iteration has not come below 1e-9 |L0| in 32 updates is
+// taken as two half steps instead (each conserves both invariants), so any spin and rate is
+// stepped. L1 is formed as the rotation of L0 the rule is, a Cayley transform:
+// (I + dt/2 S(W)) L1 = (I - dt/2 S(W)) L0 with W = K M, i.e.
+//   L1 = L0 + c (a x L0 + a x (a x L0)),   a = -dt/2 W,   c = 2 / (1 + |a|^2),
+// so |L1| = |L0| up to rounding, whatever rounding M carries. Returns L1 (kg m^2/s, body frame).
+Vec3 midpoint_momentum_step(const Vec3& inertia, const Vec3& L0, double dt, int depth) {
+  constexpr int kMaxUpdates = 32;
+  constexpr int kMaxHalvings = 24;   // 2^24 substeps: far beyond the spins the divergence check lets through
+  const Vec3 K = inertia.cwiseInverse();   // 1/(kg m^2)
+  const double half = 0.5 * dt;            // s
+  const double close = 1e-9 * L0.norm();   // kg m^2/s
+  Vec3 M = L0;
+  const auto newton_update = [&] {
+    const Vec3 KM = K.cwiseProduct(M);
+    const Vec3 F = M - L0 - half * M.cross(KM);
+    const Mat3 DF = Mat3::Identity() - half * (skew(M) * K.asDiagonal() - skew(KM));
+    const Vec3 step = DF.partialPivLu().solve(F);
+    M -= step;
+    return step.norm();
+  };
+  bool converged = false;
+  for (int i = 0; i < kMaxUpdates && !converged; ++i) converged = newton_update() <= close;
+  if (!converged && depth < kMaxHalvings) {
+    const Vec3 L_half = midpoint_momentum_step(inertia, L0, half, depth + 1);
+    return midpoint_momentum_step(inertia, L_half, half, depth + 1);
+  }
+  newton_update();
+  const Vec3 a = -half * K.cwiseProduct(M);   // rad
+  const Vec3 aL = a.cross(L0);
+  return L0 + (2.0 / (1.0 + a.squaredNorm())) * (aL + a.cross(aL));
+}
+
 }  // namespace
 
 void orthonormalize(Mat3& R) {
@@ -118,10 +170,11 @@ void integrate_body(const BodyParams& params, Gyroscopic gyroscopic, BodyState& 
 Vec3 gyroscopic_change(const BodyParams& params, Gyroscopic gyroscopic, const BodyState& body, double dt) {
   if (gyroscopic == Gyroscopic::kNeglect) return Vec3::Zero();
   const Mat3& R = body.rotation;
-  const Vec3 w_b = R.transpose() * body.angular_velocity;   // rad/s, body frame
-  const Vec3 dw_b = gyroscopic == Gyroscopic::kExplicit ? gyroscopic_explicit(params.inertia, w_b, dt)
-                                                        : gyroscopic_implicit(params.inertia, w_b, dt);
-  return R * dw_b;
+  const Vec3 w_b = R.transpose() * body.angular_velocity;              // rad/s, body frame
+  const Vec3 L0 = params.inertia.cwiseProduct(w_b);                    // kg m^2/s, body frame
+  if (w_b.cross(L0) == Vec3::Zero()) return Vec3::Zero();              // no gyroscopic term to step
+  const Vec3 L1 = midpoint_momentum_step(params.inertia, L0, dt, 0);
+  return R * (L1.cwiseQuotient(params.inertia) - w_b);
 }
 
 void move_body(const BodyParams& params, BodyState& body, const Vec3& force, const Vec3& torque, double dt) {

@@ -50,6 +50,7 @@ Session::Session(const LoadArgs& args) : scenario_(load_scenario(args)), registr
 
   options_.out = args.trace.value_or("");
   options_.trace.write = args.trace.has_value();
+  options_.trace.naming = {"trace", "trace=None writes no trace"};
   options_.trace.compression = args.compression;
   if (args.record) {
     try {

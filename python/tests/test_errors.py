@@ -1,5 +1,6 @@
 """Bad input raises a graspsim.Error naming the file and line, the field or the argument."""
 import os
+import stat
 
 import pytest
 
@@ -63,6 +64,22 @@ def test_the_output_may_not_be_an_input_and_is_left_as_it_was(tmp_path):
     with pytest.raises(ValueError, match="record 'nosuch'"):
         graspsim.load(LIFT, trace=tmp_path / "x.h5", record="nosuch")
     assert not os.path.exists(tmp_path / "x.h5")
+
+
+def test_a_trace_path_that_is_not_a_regular_file_is_refused(tmp_path):
+    # A trace is written beside its path and renamed over it: a FIFO, a socket, a device or a
+    # directory there is refused, named, with how to write no trace; it is left as it was.
+    fifo = tmp_path / "fifo.h5"
+    os.mkfifo(fifo)
+    with pytest.raises(graspsim.OutputError, match=r"trace '.*fifo\.h5' is a FIFO.*trace=None writes no trace"):
+        graspsim.load(LIFT, trace=fifo)
+    assert stat.S_ISFIFO(os.lstat(fifo).st_mode)
+    assert not os.path.exists(str(fifo) + ".partial")
+    folder = tmp_path / "folder"
+    folder.mkdir()
+    with pytest.raises(graspsim.OutputError, match="is a directory"):
+        graspsim.load(LIFT, trace=folder)
+    assert os.listdir(folder) == []
 
 
 def test_a_file_that_is_not_a_trace_is_named(tmp_path):

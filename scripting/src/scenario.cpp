@@ -101,12 +101,21 @@ Scenario Scenario::load_source(const std::string& source, const std::string& pat
     lua.lock_globals();
     lua.seed_random(initial_seed(overrides));
 
-    // Run the file: it returns the scenario table.
+    // Run the file: it returns the scenario table, and nothing else (a second value would be
+    // dropped without a word: a table meant as the scenario, or the sign of a mistake).
     const int top = lua_gettop(state);
     lua.load(s.source_, path);
-    lua.call(0, 1, Budget::kLoad);
+    lua.call(0, LUA_MULTRET, Budget::kLoad);
     detail::set_param_overrides(lua, nullptr);
     const int root = top + 1;
+    const int returned = lua_gettop(state) - top;
+    if (returned > 1) {
+      throw detail::ConversionError("the scenario must return one table (return { duration = ..., objects = ..., "
+                                    "fingers = ... }), but it returned " + std::to_string(returned) +
+                                    " values (" + luaL_typename(state, root) + ", " + luaL_typename(state, root + 1) +
+                                    (returned > 2 ? ", ..." : "") + "): only one can be the scenario");
+    }
+    if (returned == 0) lua_pushnil(state);   // a file without a return statement returns nothing
     if (lua_type(state, root) != LUA_TTABLE) {
       throw detail::ConversionError(std::string("the scenario must return a table (return { "
                                     "duration = ..., objects = ..., fingers = ... }), but it "

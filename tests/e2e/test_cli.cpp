@@ -30,6 +30,22 @@ TEST_CASE("graspsim --help explains the command and exits 0", "[cli]") {
   CHECK(cli("run --help").status == 0);
 }
 
+// A rehearsal's own stall and lag limits (--pace with simulated devices) are refused with a hand
+// on a real device, before any device opens: such a device is released after 20 ms without a
+// fresh force whatever the machine.
+TEST_CASE("a rehearsal's --stall-timeout and --lag-limit are refused with a real device", "[cli][bad_input][pacing]") {
+  const std::string lift = std::string(GRASPSIM_SOURCE_DIR) + "/scenarios/two_finger_lift.lua";
+  for (const std::string option : {"--stall-timeout 1", "--lag-limit 1"}) {
+    const Outcome o = cli("run " + lift + " --pace " + option + " --device thumb=udp:127.0.0.1:9 --out " + kTmp +
+                          "/cli_limits.h5");
+    INFO(o.output);
+    CHECK(o.status == 2);
+    CHECK_THAT(o.output, Catch::Contains(option.substr(0, option.find(' ')) +
+                                         " is for a rehearsal (--pace with simulated devices)"));
+    CHECK_THAT(o.output, !Catch::Contains("pacing"));
+  }
+}
+
 // Each bad input ends with exit status 2 and a message that names the problem: the file and
 // line for Lua errors, the field for bad values.
 TEST_CASE("bad input gives exit status 2 and names the problem", "[cli][bad_input]") {
@@ -62,6 +78,82 @@ TEST_CASE("bad input gives exit status 2 and names the problem", "[cli][bad_inpu
     INFO("graspsim " << c.args << "\n" << o.output);
     CHECK(o.status == 2);
     for (const std::string& s : c.says) CHECK_THAT(o.output, Catch::Contains(s));
+  }
+}
+
+// One command table: every subcommand parses its arguments the same way and, with an error in
+// them, names it and shows its own usage, not another command's (`graspsim compare A B --bogus`
+// once printed run's). Each subcommand's errors: an unknown option, a value missing or refused,
+// too many or too few operands, options that exclude each other.
+TEST_CASE("each subcommand refuses bad arguments with exit 2, naming them, and shows its own usage",
+          "[cli][bad_input][usage]") {
+  const std::string lift = std::string(GRASPSIM_SOURCE_DIR) + "/scenarios/two_finger_lift.lua";
+  const std::string a = kTmp + "/cli_usage_a.h5";
+  struct Case {
+    std::string args;
+    std::string says;
+  };
+  const std::vector<std::pair<std::string, std::vector<Case>>> commands = {
+      {"run",
+       {{"run " + lift + " --bogus", "unknown option '--bogus'"},
+        {"run", "run needs a scenario file"},
+        {"run " + lift + " " + lift, "one scenario at a time"},
+        {"run " + lift + " --port 70000 --view", "--port needs a port number from 0 to 65535 (got '70000')"},
+        {"run " + lift + " --compress 10", "--compress needs a level from 1 to 9 (got '10')"},
+        {"run " + lift + " --summary", "--summary needs a file name"},
+        {"run " + lift + " --stall-timeout 1", "--stall-timeout is a limit of a rehearsal: it needs --pace"},
+        {"run " + lift + " --pace --lag-limit 0", "--lag-limit needs a time in s, more than 0 and at most 86400"},
+        {"run " + lift + " --no-trace --out x.h5", "--no-trace writes no trace, so it takes no --out"}}},
+      {"sweep",
+       {{"sweep " + lift + " --grid mu=0.5 --out x --bogus", "unknown option '--bogus'"},
+        {"sweep --grid mu=0.5 --out x", "sweep needs a scenario file"},
+        {"sweep " + lift + " --grid mu=0.5", "sweep needs --out DIR"},
+        {"sweep " + lift + " --jobs 0 --grid mu=0.5 --out x", "--jobs needs a whole number from 1 to 4096 (got '0')"},
+        {"sweep " + lift + " --out x", "nothing to sweep"}}},
+      {"replay",
+       {{"replay " + a + " --bogus", "unknown option '--bogus'"},
+        {"replay", "replay needs a trace file"},
+        {"replay " + a + " " + a, "one trace at a time"},
+        {"replay " + a + " --compress x", "--compress needs a level from 1 to 9 (got 'x')"},
+        {"replay " + a + " --out", "--out needs a file name"}}},
+      {"repair",
+       {{"repair " + a + " --bogus", "unknown option '--bogus'"},
+        {"repair", "repair needs exactly one trace file"},
+        {"repair " + a + " " + a, "one trace at a time"}}},
+      {"sweep-task",
+       {{"sweep-task " + a + " 1 --bogus", "unknown option '--bogus'"},
+        {"sweep-task " + a, "sweep-task needs a sweep's folder and a run's number"},
+        {"sweep-task " + a + " one", "sweep-task needs a sweep's folder and a run's number"}}},
+      {"view",
+       {{"view " + a + " --bogus", "unknown option '--bogus'"},
+        {"view", "view needs a trace file"},
+        {"view " + a + " " + a + " " + a, "at most two traces"},
+        {"view " + a + " --port -1", "--port needs a port number from 0 to 65535 (got '-1')"}}},
+      {"compare",
+       {{"compare " + a + " " + a + " --bogus", "unknown option '--bogus'"},
+        {"compare " + a, "compare needs two trace files (got 1)"},
+        {"compare " + a + " " + a + " --view --port 65536", "--port needs a port number from 0 to 65535"},
+        {"compare " + a + " " + a + " --port 8000", "--port is for the view: add --view"},
+        {"compare " + a + " " + a + " --open", "--open is for the view: add --view"},
+        {"compare " + a + " " + a + " --only", "--only needs a loop"}}},
+  };
+  for (const auto& [command, cases] : commands) {
+    for (const Case& c : cases) {
+      const Outcome o = cli(c.args);
+      INFO("graspsim " << c.args << "\n" << o.output);
+      CHECK(o.status == 2);
+      CHECK_THAT(o.output, Catch::Contains("graspsim " + command + ": " + c.says));
+      CHECK_THAT(o.output, Catch::Contains("usage: graspsim " + command + " "));
+      for (const auto& [other, unused] : commands)
+        if (other != command) CHECK_THAT(o.output, !Catch::Contains("usage: graspsim " + other + " "));
+    }
+  }
+  // Each answers --help with its own help, exit 0.
+  for (const auto& [command, unused] : commands) {
+    const Outcome o = cli(command + " --help");
+    INFO(command << " --help\n" << o.output);
+    CHECK(o.status == 0);
+    CHECK_THAT(o.output, Catch::Contains("usage: graspsim " + command));
   }
 }
 

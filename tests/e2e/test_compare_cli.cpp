@@ -9,9 +9,16 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <chrono>
+#include <csignal>
 #include <string>
 #include <sys/wait.h>
+#include <thread>
+
+#include "app/json.hpp"
+#include "tests/support/process.hpp"
 #include "tests/support/shell.hpp"
+#include "tests/support/skip.hpp"
 #include "tests/support/trace_edit.hpp"
 
 namespace {
@@ -235,4 +242,76 @@ TEST_CASE("graspsim compare --help explains tolerances, exit codes and h5diff", 
   for (const char* s : {"--atol", "--rtol", "--tol PATTERN=ATOL", "--bitwise", "--json", "--attributes",
                         "exit status", "h5diff", "servo/*"})
     CHECK_THAT(o.output, Catch::Contains(s));
+}
+
+// Two files whose /physics is missing, or a scalar dataset where the table should be, are not
+// "the same": compare_traces compares the tables both hold (here /servo and /haptic, equal) and
+// passes over the rest, so without a check they compared equal, exit 0. Each trace's root
+// attribute `record` names physics, so a table with a tick column must be there: exit 2, naming
+// the file and what is wrong. A trace that did not --record physics still compares (exit 0).
+TEST_CASE("graspsim compare refuses traces whose /physics is missing or a scalar", "[compare_cli][bad_input]") {
+  if (graspsim::test::shell("/usr/bin/python3 -c 'import h5py'").status != 0)
+    GRASPSIM_SKIP("no python3-h5py to edit the traces with");
+  const std::string a = kTmp + "/compare_cli_physics_a.h5";
+  run_lift(a);
+  const auto edited = [&](const std::string& name, const std::string& edit) {
+    const std::string path = kTmp + "/compare_cli_physics_" + name + ".h5";
+    std::filesystem::remove(path);
+    std::filesystem::copy_file(a, path);
+    const Outcome o = graspsim::test::shell("/usr/bin/python3 -c \"import h5py, sys; f = h5py.File(sys.argv[1], 'a'); " +
+                                            edit + "\" " + path);
+    INFO(o.output);
+    REQUIRE(o.status == 0);
+    return path;
+  };
+  const std::string missing = edited("missing", "del f['physics']");
+  const std::string scalar = edited("scalar", "del f['physics']; f['physics'] = 0.0");
+  struct Case {
+    std::string a, b, says;
+  };
+  for (const Case& c : {Case{missing, missing, "/physics is missing"}, Case{scalar, scalar, "/physics is a plain dataset"},
+                        Case{a, missing, "/physics is missing"}, Case{scalar, a, "/physics is a plain dataset"}}) {
+    for (const std::string json : {"", " --json"}) {
+      const Outcome o = cli("compare " + c.a + " " + c.b + json);
+      INFO("compare " << c.a << " " << c.b << json << "\n" << o.output);
+      CHECK(o.status == 2);
+      CHECK_THAT(o.output, Catch::Contains("is not a whole graspsim trace: " + c.says) &&
+                               Catch::Contains("its root attribute record is 'servo:1,haptic:1,physics:1,devices:1'"));
+    }
+  }
+  const std::string servo_only = kTmp + "/compare_cli_servo_only.h5";
+  run_lift(servo_only, "--record servo,haptic");
+  CHECK(cli("compare " + servo_only + " " + servo_only).status == 0);
+}
+
+// compare --view serves the page where --port says, as `graspsim view` does (0: any free port,
+// printed); stopped by SIGINT it exits 0.
+TEST_CASE("graspsim compare --view takes --port", "[compare_cli][view]") {
+  const std::string a = kTmp + "/compare_cli_view.h5";
+  run_lift(a);
+  const std::string log = kTmp + "/compare_cli_view.log";
+  graspsim::test::Child child({kCli, "compare", a, a, "--view", "--port", "0"}, log);
+  std::string printed;
+  for (int i = 0; i < 6000 && child.running(); ++i) {   // until it prints its URL (at most 60 s)
+    printed = graspsim::test::file_bytes(log).value_or("");
+    if (printed.find("url  http://127.0.0.1:") != std::string::npos) break;
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  INFO(printed);
+  REQUIRE_THAT(printed, Catch::Contains("SAME") && Catch::Contains("url  http://127.0.0.1:"));
+  CHECK_THAT(printed, !Catch::Contains("http://127.0.0.1:8717/"));   // not the default: any free port
+  REQUIRE(kill(child.pid(), SIGINT) == 0);
+  const graspsim::test::Ended e = child.wait();
+  CHECK(e.status == 0);
+}
+
+// The one JSON escaper (app/json.hpp), which compare's --json and the view's scene both use:
+// quotes and backslashes escaped, control bytes as \n \r \t or \u00XX, the rest as it is.
+TEST_CASE("the JSON escaper escapes what RFC 8259 requires and keeps the rest", "[compare_cli][json]") {
+  CHECK(graspsim::app::json_string("") == "\"\"");
+  CHECK(graspsim::app::json_string("box \"a\" \\ b") == "\"box \\\"a\\\" \\\\ b\"");
+  CHECK(graspsim::app::json_string("l1\nl2\r\t") == "\"l1\\nl2\\r\\t\"");
+  CHECK(graspsim::app::json_string(std::string("\x01\x1f\x7f", 3)) == "\"\\u0001\\u001f\x7f\"");
+  CHECK(graspsim::app::json_string("caf\xc3\xa9") == "\"caf\xc3\xa9\"");
+  CHECK(JsonChecker(graspsim::app::json_string(std::string("\0\b\f/x", 5))).valid());
 }

@@ -6,7 +6,10 @@
 // the machine cannot run (no tmpfs mount) is reported as skipped by ctest, not passed.
 #include <catch2/catch.hpp>
 
+#include <sys/socket.h>
+#include <sys/stat.h>
 #include <sys/syscall.h>
+#include <sys/un.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -303,6 +306,122 @@ TEST_CASE("catalogue: an output that is an input, or a link to one, is refused a
       CHECK_FALSE(exists(dir + "/" + std::string(partial)));
     fs::remove(dir + "/rec.h5.partial");
   }
+  fs::remove_all(dir);
+}
+
+// ---------------------------------------------------------------------------------------------
+// An output path that is not a regular file. Every command writes beside its output and renames
+// over it, which as root would put a regular file in place of a device (`--out /dev/null`: for
+// every program on the machine), a FIFO or a socket. Each is refused before anything runs, exit 2,
+// naming the path, what it is and how to write nothing; the thing at the path is still what it
+// was, no partial is left, and nothing hangs (a FIFO opened to write would wait for a reader:
+// each command runs under `timeout`). Tested where it can harm nothing: a FIFO, a socket, a
+// directory and a link to the FIFO in a temporary folder (devices in the next test).
+namespace {
+
+// A Unix socket bound at `path` (closed again: the socket file stays).
+bool make_socket(const std::string& path) {
+  const int fd = ::socket(AF_UNIX, SOCK_STREAM, 0);
+  if (fd < 0) return false;
+  sockaddr_un address{};
+  address.sun_family = AF_UNIX;
+  std::snprintf(address.sun_path, sizeof address.sun_path, "%s", path.c_str());
+  const bool bound = ::bind(fd, reinterpret_cast<const sockaddr*>(&address), sizeof address) == 0;
+  ::close(fd);
+  return bound;
+}
+
+fs::file_type type_of(const std::string& path) {
+  std::error_code ec;
+  return fs::symlink_status(path, ec).type();
+}
+
+}  // namespace
+
+TEST_CASE("catalogue: an output that is a FIFO, a socket or a directory is refused, naming how to write none",
+          "[fault_catalogue][not_a_file]") {
+  const std::string dir = fresh_dir("not_a_file");
+  fs::copy_file(kLift, dir + "/lift.lua");
+  REQUIRE(cli_in(dir, "run lift.lua --quiet --out rec.h5").status == 0);
+  REQUIRE(::mkfifo((dir + "/fifo").c_str(), 0644) == 0);
+  REQUIRE(make_socket(dir + "/sock"));
+  fs::create_directory(dir + "/folder");
+  fs::create_symlink("fifo", dir + "/fifo_link");
+  REQUIRE(::mkfifo((dir + "/x.h5.partial").c_str(), 0644) == 0);
+  // A finished one-run sweep whose table's name a FIFO has taken since: its --resume writes the
+  // table at once, and must not replace the FIFO.
+  REQUIRE(cli_in(dir, "sweep lift.lua --grid mu=1.2 --jobs 1 --out sweep").status == 0);
+  fs::remove(dir + "/sweep/sweep.csv");
+  REQUIRE(::mkfifo((dir + "/sweep/sweep.csv").c_str(), 0644) == 0);
+  struct Case {
+    std::string args;
+    std::vector<std::string> says;
+  };
+  const std::vector<Case> cases = {
+      {"run lift.lua --quiet --out fifo", {"--out 'fifo' is a FIFO, not a regular file", "--no-trace writes no trace"}},
+      {"run lift.lua --quiet --out sock", {"--out 'sock' is a socket, not a regular file", "--no-trace"}},
+      {"run lift.lua --quiet --out folder", {"--out 'folder' is a directory, not a regular file", "name a file in it", "--no-trace"}},
+      {"run lift.lua --quiet --out fifo_link", {"--out 'fifo_link' is a symbolic link to a FIFO", "--no-trace"}},
+      {"run lift.lua --quiet --out x.h5", {"written as 'x.h5.partial'", "taken by a FIFO"}},
+      {"run lift.lua --no-trace --summary fifo", {"--summary 'fifo' is a FIFO", "leave out --summary to write none"}},
+      {"replay rec.h5 --quiet --out fifo", {"--out 'fifo' is a FIFO", "a replay writes its trace", "name a file with --out"}},
+      {"replay rec.h5 --quiet --out sock", {"--out 'sock' is a socket"}},
+      {"sweep lift.lua --grid mu=0.5 --out fifo", {"--out fifo is a FIFO, not a folder"}},
+      {"sweep lift.lua --grid mu=1.2 --jobs 1 --out sweep --resume", {"sweep/sweep.csv is a FIFO, not a regular file"}},
+  };
+  for (const Case& c : cases) {
+    const Outcome o = graspsim::test::shell("cd '" + dir + "' && timeout 60 " + kCli + " " + c.args);
+    INFO("graspsim " << c.args << "\n" << o.output);
+    CHECK(o.status == 2);
+    for (const std::string& s : c.says) CHECK_THAT(o.output, Catch::Contains(s));
+    CHECK(type_of(dir + "/fifo") == fs::file_type::fifo);
+    CHECK(type_of(dir + "/sock") == fs::file_type::socket);
+    CHECK(type_of(dir + "/folder") == fs::file_type::directory);
+    CHECK(type_of(dir + "/fifo_link") == fs::file_type::symlink);
+    CHECK(type_of(dir + "/x.h5.partial") == fs::file_type::fifo);
+    CHECK(type_of(dir + "/sweep/sweep.csv") == fs::file_type::fifo);
+    for (const char* partial : {"fifo.partial", "sock.partial", "folder.partial", "fifo_link.partial"})
+      CHECK_FALSE(exists(dir + "/" + std::string(partial)));
+    CHECK(fs::is_empty(dir + "/folder"));
+  }
+  fs::remove_all(dir);
+}
+
+// The devices themselves, /dev/null and /dev/full, only where they can harm nothing: in a mount
+// namespace of the test's own (`unshare -m`, propagation private) with a tmpfs of its own on
+// /dev holding fresh device nodes (mknod 1,3 and 1,7). The script checks that it runs in another
+// mount namespace than the test's before it mounts anything; the machine's /dev is never
+// touched. Skipped, saying why, where the namespace, the tmpfs or the nodes cannot be made
+// (unshare missing, not root, no CAP_SYS_ADMIN or CAP_MKNOD).
+TEST_CASE("catalogue: --out /dev/null and /dev/full are refused, in a private /dev", "[fault_catalogue][not_a_file]") {
+  char outer[64] = {};
+  REQUIRE(::readlink("/proc/self/ns/mnt", outer, sizeof outer - 1) > 0);
+  const std::string script =
+      "set -u\n"
+      "[ \"$(readlink /proc/self/ns/mnt)\" != \"$GRASPSIM_OUTER_NS\" ] || { echo 'not in a new mount namespace'; exit 77; }\n"
+      "mount --make-rprivate / || { echo 'cannot make the namespace private'; exit 77; }\n"
+      "mount -t tmpfs -o size=1m,mode=755 graspsim-test-dev /dev || { echo 'cannot mount a tmpfs on /dev'; exit 77; }\n"
+      "mknod -m 666 /dev/null c 1 3 && mknod -m 666 /dev/full c 1 7 || { echo 'cannot make device nodes'; exit 77; }\n"
+      "for dev in /dev/null /dev/full; do\n"
+      "  \"$GRASPSIM_CLI\" run \"$GRASPSIM_LIFT\" --quiet --out $dev; echo \"exit $dev $?\"\n"
+      "  [ -c $dev ] && echo \"still a device: $dev\"\n"
+      "done\n"
+      "echo \"left in /dev: $(ls -A /dev | tr '\\n' ' ')\"\n";
+  const std::string dir = fresh_dir("dev_null");
+  write_file(dir + "/private_dev.sh", script);
+  const Outcome o = graspsim::test::shell("cd '" + dir + "' && GRASPSIM_OUTER_NS='" + std::string(outer) +
+                                          "' GRASPSIM_CLI='" + kCli + "' GRASPSIM_LIFT='" + kLift +
+                                          "' timeout 120 unshare -m --propagation private sh private_dev.sh");
+  INFO(o.output);
+  if (o.status == 77 || o.output.find("unshare: ") != std::string::npos)
+    GRASPSIM_SKIP("no private /dev to test in: " << o.output);
+  REQUIRE(o.status == 0);
+  for (const std::string dev : {"/dev/null", "/dev/full"}) {
+    CHECK_THAT(o.output, Catch::Contains("--out '" + dev + "' is a character device, not a regular file"));
+    CHECK_THAT(o.output, Catch::Contains("exit " + dev + " 2"));
+    CHECK_THAT(o.output, Catch::Contains("still a device: " + dev));
+  }
+  CHECK_THAT(o.output, Catch::Contains("left in /dev: full null \n"));
   fs::remove_all(dir);
 }
 

@@ -13,6 +13,9 @@
 #include <sys/wait.h>
 #include <vector>
 
+#include "app/devices.hpp"
+#include "app/pacer.hpp"
+#include "app/run.hpp"
 #include "graspsim/hw/udp_device.hpp"
 #include "graspsim/recordings/trace_reader.hpp"
 #include "graspsim/scripting/scenario.hpp"
@@ -371,15 +374,29 @@ TEST_CASE("graspsim run without lockstep against a lockstep device_server exits 
 // A streamed device and the run start their clocks together. device_server --replay streams a
 // recorded thumb at the run's servo rate on its own clock; that clock starts at the run's first
 // tick (the first force datagram, tick 0's), not at the hello, which comes about half a second
-// earlier while the run sets up: otherwise the first tick would receive sample 255 or later,
-// and the replayed thumb would lead the scripted index for the whole lift (4 of 5 expectations fail).
-// Law: the lift is its recorded motion only if tick n gets about row n. Tick 0 reads sample 0
-// (the hello's answer); afterwards the stream trails the run by the time the server took to see
-// tick 0's force (scheduling, well under 10 ms = 30 ticks; measured 0.3 to 1.3 ms) and is never
-// ahead of it, where a clock started at the hello leads by the whole set-up. Real time, 4 s; the
-// run is paced (SCHED_FIFO as root).
+// earlier while the run sets up: otherwise tick 1 would already read sample 1500 or so, and the
+// replayed thumb would lead the scripted index for the whole lift (4 of 5 expectations fail).
+// What is asserted is what holds whatever the scheduler does:
+//  - tick 0 reads sample 0 (the hello's answer);
+//  - no tick reads a sample ahead of itself unless the run was behind its schedule: sample k
+//    leaves the server at t0 + (k - 1) T, t0 the arrival of tick 0's force, after tick 0's read
+//    and render; an on-time tick n reads at start + n T plus its own read time, so it can hold
+//    sample n + 1 at most. A later sample means tick n or n - 1 ended past its deadline, which
+//    the run flags in /devices/thumb/overrun; a clock started at the hello breaks this at once;
+//  - no sample is skipped: the new samples the bridge took add up to the last one's number + 1
+//    (a datagram lost on the way, or one sample overwritten by the next, would leave a gap);
+//  - the stream trails the run by less than 300 ticks (100 ms, a hand's reaction time) at the
+//    median: its samples go out on the server's clock, late only as long as the server waits
+//    for the CPU;
+//  - the lift meets its 5 expectations: the replayed thumb is in step with the scripted index.
+// The run is paced in real time, as `graspsim run --device thumb=udp:...` paces it, but with its
+// stall and lag limits out of the way (1 h): they stop a session whose loop waits more than 20 ms,
+// which a FIFO thread on this 2-core VM does under load (measured up to 26 ms with two CPU hogs),
+// so here they would only measure the machine; they are tested on an injected clock in
+// test_pacer.cpp. Real time, 4 s.
 TEST_CASE("a streamed device_server replay starts its clock at the run's first tick: the lift meets all 5 "
           "expectations", "[e2e][udp][devices][streaming]") {
+  namespace app = graspsim::app;
   const std::string cli = GRASPSIM_CLI;
   const std::string lift = std::string(GRASPSIM_SOURCE_DIR) + "/scenarios/two_finger_lift.lua";
   const std::string tmp = GRASPSIM_TEST_TMP;
@@ -387,27 +404,50 @@ TEST_CASE("a streamed device_server replay starts its clock at the run's first t
   REQUIRE(graspsim::test::shell(cli + " run " + lift + " --quiet --out " + recorded).status == 0);
   Server server("--replay " + recorded + " --finger thumb --print-every 100000000 --idle-exit 2", false);
   CHECK_THAT(server.first_line(), Catch::Contains("streaming"));
-  const std::string session = tmp + "/udp_stream_session.h5";
-  const auto run = graspsim::test::shell(cli + " run " + lift + " --out " + session +
-                                         " --device thumb=udp:127.0.0.1:" + std::to_string(server.port()));
-  INFO(run.output);
-  CHECK(run.status == 0);
-  CHECK_THAT(run.output, Catch::Contains("pacing"));
-  CHECK_THAT(run.output, Catch::Contains("all 5 expectations met"));
-  const auto sequence = graspsim::recordings::read_dataset(session, "/devices/thumb/sequence").values;
+  const auto scenario = graspsim::scripting::Scenario::load(lift);
+  const app::DeviceRegistry registry = app::default_registry();
+  const app::DevicePlan plan =
+      app::plan_devices(scenario, {"thumb=udp:127.0.0.1:" + std::to_string(server.port())}, registry);
+  REQUIRE(plan.any_real());
+  app::SteadyClock steady;
+  app::Pacer pacer(steady, scenario.model().rates.servo, 3600.0, 3600.0);
+  app::RunOptions o;
+  o.out = tmp + "/udp_stream_session.h5";
+  o.inputs = plan.files;
+  o.devices.record = plan.recorded();
+  o.devices.script_alongside = plan.script_alongside;
+  o.devices.make = [&](std::size_t f) { return app::make_device(plan, registry, scenario, f); };
+  o.pacing.pacer = &pacer;
+  o.pacing.realtime = app::probe_realtime().empty();
+  const app::RunResult r = app::run_scenario(scenario, o);
+  INFO(r.error << "\npacing: " << r.pacing);
+  REQUIRE(r.error.empty());
+  REQUIRE(r.expectations.size() == 5);
+  for (const auto& e : r.expectations) {
+    INFO(e.what << ": " << e.detail);
+    CHECK(e.passed);
+  }
+  const auto sequence = graspsim::recordings::read_dataset(o.out, "/devices/thumb/sequence").values;
+  const auto fresh = graspsim::recordings::read_dataset(o.out, "/devices/thumb/new_samples").values;
+  const auto overrun = graspsim::recordings::read_dataset(o.out, "/devices/thumb/overrun").values;
   REQUIRE(sequence.size() == 12000);
   CHECK(sequence[0] == 0.0);   // tick 0 reads sample 0: the clock did not run before the run
+  std::size_t ahead_on_time = 0, behind = 0;
+  double taken = 0.0;
   std::vector<double> lag(sequence.size());   // ticks: how far the stream trails the run
-  std::size_t ahead = 0;
   for (std::size_t n = 0; n < sequence.size(); ++n) {
     lag[n] = static_cast<double>(n) - sequence[n];
-    ahead += lag[n] < 0.0;
+    taken += fresh[n];
+    const bool late = overrun[n] != 0.0 || (n > 0 && overrun[n - 1] != 0.0);
+    ahead_on_time += sequence[n] > static_cast<double>(n + 1) && !late;
+    behind += late;
   }
   std::nth_element(lag.begin(), lag.begin() + 6000, lag.end());
-  INFO("median lag " << lag[6000] << " ticks; ticks whose sample was ahead of the run: " << ahead);
-  CHECK(lag[6000] >= 0.0);
-  CHECK(lag[6000] <= 30.0);
-  CHECK(ahead <= 120);   // 1 %: an overrun tick may read a later sample; none measured
+  INFO("ticks that read a sample ahead of themselves on time: " << ahead_on_time << "; ticks at or after an overrun: "
+                                                                 << behind << "; median lag " << lag[6000] << " ticks");
+  CHECK(ahead_on_time == 0);
+  CHECK(taken == sequence.back() + 1.0);   // no sample skipped
+  CHECK(lag[6000] < 300.0);
   int status = -1;
   server.finish(&status);
   CHECK(status == 0);

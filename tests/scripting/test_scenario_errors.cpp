@@ -70,6 +70,15 @@ TEST_CASE("a file that does not return a table is an error saying so", "[scenari
                "fingers = ... }), but it returned nil");
 }
 
+// Lua keeps only the first of several values where one is asked for; a scenario file's second
+// table (a scenario meant to run, or a stray value) is refused, naming the file, not dropped.
+TEST_CASE("a file that returns two tables is refused, naming the file", "[scenario][errors]") {
+  const std::string path = data_path("two_tables.lua");
+  CHECK(load_error(path) ==
+        path + ": the scenario must return one table (return { duration = ..., objects = ..., fingers = ... }), but "
+               "it returned 2 values (table, table): only one can be the scenario");
+}
+
 TEST_CASE("an endless loop while loading stops with the budget message", "[scenario][errors]") {
   LoadOptions options;
   options.limits.load_instructions = 2'000'000;   // the default 2e8 takes about a second

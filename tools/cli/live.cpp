@@ -11,31 +11,15 @@
 
 namespace graspsim::cli {
 
-bool parse_live_option(const std::vector<std::string>& args, std::size_t& i, LiveOptions& live, std::string& error) {
-  const std::string& a = args[i];
-  if (a == "--view") {
-    live.view = true;
-  } else if (a == "--no-view") {
-    live.no_view = true;
-  } else if (a == "--open") {
-    live.open = true;
-  } else if (a == "--port") {
-    const std::string v = i + 1 < args.size() ? args[++i] : "";
-    char* end = nullptr;
-    const long p = std::strtol(v.c_str(), &end, 10);
-    if (v.empty() || *end != '\0' || p < 0 || p > 65535)
-      error = "--port needs a port number from 0 to 65535 (got '" + v + "')";
-    live.port = static_cast<int>(p);
-  } else {
-    return false;
-  }
-  return true;
+std::vector<Option> live_options(LiveOptions& live) {
+  return {flag("--view", live.view), flag("--no-view", live.no_view), flag("--open", live.open),
+          port(live.port, live.port_given)};
 }
 
 std::string check_live_options(const LiveOptions& live, bool paced) {
   if (live.view && live.no_view) return "--view and --no-view contradict each other: give one";
   const bool viewed = live.view || (paced && !live.no_view);
-  if (!viewed && (live.port >= 0 || live.open))
+  if (!viewed && (live.port_given || live.open))
     return std::string(live.open ? "--open" : "--port") + " is for the live view: add --view" +
            (paced ? " (or drop --no-view)" : "");
   return "";
@@ -49,11 +33,10 @@ std::string LiveSession::start(const scripting::Scenario& scenario, const LiveOp
   channel_.emplace(model.bodies.size(), model.fingers.size());
   try {
     const std::string web = view::web_folder();
-    const int port = live.port >= 0 ? live.port : kDefaultViewPort;
     try {
-      server_ = std::make_unique<view::LiveServer>(scenario, *channel_, web, port);
+      server_ = std::make_unique<view::LiveServer>(scenario, *channel_, web, live.port);
     } catch (const view::ViewError&) {
-      if (asked || live.port >= 0) throw;
+      if (asked || live.port_given) throw;
       server_ = std::make_unique<view::LiveServer>(scenario, *channel_, web, 0);   // the default port is taken
     }
   } catch (const view::ViewError& e) {

@@ -9,20 +9,22 @@
 
 #include "app/live_channel.hpp"
 #include "app/run.hpp"
+#include "cli/options.hpp"
+#include "cli/view.hpp"
 #include "view/server/live.hpp"
 
 namespace graspsim::cli {
 
 struct LiveOptions {
-  bool view = false;      // --view
-  bool no_view = false;   // --no-view
-  bool open = false;      // --open
-  int port = -1;          // --port N (-1: not given)
+  bool view = false;         // --view
+  bool no_view = false;      // --no-view
+  bool open = false;         // --open
+  int port = kDefaultViewPort;   // --port N
+  bool port_given = false;
 };
 
-// Takes args[i] (and its value, advancing i) if it is --view, --no-view, --open or --port N:
-// true when taken; `error` set when its value is bad.
-bool parse_live_option(const std::vector<std::string>& args, std::size_t& i, LiveOptions& live, std::string& error);
+// --view, --no-view, --open and --port N, for a command's table (options.hpp).
+std::vector<Option> live_options(LiveOptions& live);
 
 // The combinations refused: --view with --no-view; --port or --open without a view. "" when fine.
 std::string check_live_options(const LiveOptions& live, bool paced);

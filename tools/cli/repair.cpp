@@ -5,6 +5,7 @@
 #include <iostream>
 
 #include "app/output_file.hpp"
+#include "cli/options.hpp"
 #include "graspsim/recordings/trace_repair.hpp"
 #include "graspsim/recordings/trace_writer.hpp"
 
@@ -24,29 +25,20 @@ constexpr const char* kRepairHelp =
     "exit status: 0 repaired or nothing to repair, 2 bad input (not a graspsim trace, or it\n"
     "cannot be repaired).\n";
 
-}  // namespace
-
-int repair_command(const std::vector<std::string>& args) {
-  if (args.size() == 1 && (args[0] == "-h" || args[0] == "--help")) {
-    std::cout << kRepairHelp;
-    return 0;
-  }
-  if (args.size() != 1 || args[0].empty() || args[0].front() == '-') {
-    std::cerr << "graspsim: repair needs exactly one trace file\n" << kRepairHelp;
-    return 2;
-  }
-  if (app::locked_by_a_run(args[0])) {
-    std::cerr << "graspsim: '" << args[0] << "' is being written by a graspsim run (it is locked): "
+// Repairs the trace at `path` unless a run holds it; the exit status.
+int repair(const std::string& path) {
+  if (app::locked_by_a_run(path)) {
+    std::cerr << "graspsim: '" << path << "' is being written by a graspsim run (it is locked): "
               << "it is not cut; repair it only if that run is killed\n";
     return 2;
   }
   try {
-    const recordings::RepairResult r = recordings::repair_trace(args[0]);
+    const recordings::RepairResult r = recordings::repair_trace(path);
     if (r.repaired) {
-      std::cout << "graspsim: repaired '" << args[0] << "': status \"" << r.status_after << "\", "
+      std::cout << "graspsim: repaired '" << path << "': status \"" << r.status_after << "\", "
                 << r.servo_rows << " servo ticks kept\n";
     } else {
-      std::cout << "graspsim: '" << args[0] << "' was not cut (status \"" << r.status_before
+      std::cout << "graspsim: '" << path << "' was not cut (status \"" << r.status_before
                 << "\"); nothing to repair\n";
     }
     return 0;
@@ -54,6 +46,25 @@ int repair_command(const std::vector<std::string>& args) {
     std::cerr << "graspsim: " << e.what() << "\n";
     return 2;
   }
+}
+
+}  // namespace
+
+int repair_command(const std::vector<std::string>& args) {
+  std::string trace;
+  CommandLine line{"repair", "usage: graspsim repair TRACE.h5\n", kRepairHelp, {}, {}};
+  line.operand = [&trace](const std::string& v) -> std::string {
+    if (!trace.empty()) return "one trace at a time (got '" + trace + "' and '" + v + "')";
+    trace = v;
+    return "";
+  };
+  switch (parse_command_line(line, args)) {
+    case Parsed::kHelp: return 0;
+    case Parsed::kError: return 2;
+    case Parsed::kGo: break;
+  }
+  if (trace.empty()) return usage_error(line, "repair needs exactly one trace file");
+  return repair(trace);
 }
 
 }  // namespace graspsim::cli

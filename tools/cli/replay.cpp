@@ -11,6 +11,7 @@
 #include "app/replay.hpp"
 #include "app/run_budget.hpp"
 #include "app/run.hpp"
+#include "cli/options.hpp"
 #include "cli/report.hpp"
 #include "graspsim/recordings/trace_compare.hpp"
 
@@ -66,41 +67,26 @@ int replay_command(const std::vector<std::string>& args, const std::atomic<bool>
                    const std::atomic<int>* signal) {
   std::string trace, out;
   app::ReplayOptions replay;
-  int compression = 0;
+  long long compression = 0;
   bool quiet = false;
-  for (std::size_t i = 0; i < args.size(); ++i) {
-    const std::string& a = args[i];
-    const std::string* v = (i + 1 < args.size()) ? &args[i + 1] : nullptr;
-    const auto take = [&] { ++i; };
-    if (a == "-h" || a == "--help") {
-      std::cout << kReplayHelp;
-      return 0;
-    } else if (a == "--out") {
-      if (!v || v->empty() || v->front() == '-') return bad_input("--out needs a file name");
-      out = *v, take();
-    } else if (a == "--set") {
-      if (!v || v->find('=') == std::string::npos || v->front() == '=')
-        return bad_input("--set needs NAME=VALUE" + (v ? " (got '" + *v + "')" : std::string()));
-      replay.sets.push_back(*v), take();
-    } else if (a == "--scenario-dir") {
-      if (!v || v->empty()) return bad_input("--scenario-dir needs a directory");
-      replay.scenario_dir = *v, take();
-    } else if (a == "--compress") {
-      char* end = nullptr;
-      const long level = v ? std::strtol(v->c_str(), &end, 10) : 0;
-      if (!v || *end != '\0' || level < 1 || level > 9) return bad_input("--compress needs a level from 1 to 9");
-      compression = static_cast<int>(level), take();
-    } else if (a == "--quiet") {
-      quiet = true;
-    } else if (a.rfind("-", 0) == 0) {
-      return bad_input("unknown option '" + a + "' (graspsim replay --help)");
-    } else if (trace.empty()) {
-      trace = a;
-    } else {
-      return bad_input("one trace at a time (got '" + trace + "' and '" + a + "')");
-    }
+  CommandLine line{"replay", "usage: graspsim replay TRACE.h5 [--out NEW.h5] [--set NAME=VALUE]... [--scenario-dir DIR]\n"
+                             "                [--compress N] [--quiet]\n",
+                   kReplayHelp,
+                   {text("--out", "a file name", out), set_option(replay.sets),
+                    text("--scenario-dir", "a directory", replay.scenario_dir),
+                    count("--compress", "a level from 1 to 9", 1, 9, compression), flag("--quiet", quiet)},
+                   {}};
+  line.operand = [&trace](const std::string& v) -> std::string {
+    if (!trace.empty()) return "one trace at a time (got '" + trace + "' and '" + v + "')";
+    trace = v;
+    return "";
+  };
+  switch (parse_command_line(line, args)) {
+    case Parsed::kHelp: return kExitOk;
+    case Parsed::kError: return kExitBadInput;
+    case Parsed::kGo: break;
   }
-  if (trace.empty()) return bad_input("replay needs a trace file (graspsim replay --help)");
+  if (trace.empty()) return usage_error(line, "replay needs a trace file");
   if (out.empty()) out = app::default_replay_out(trace);
   std::error_code ec;
   if (std::filesystem::equivalent(trace, out, ec) || std::filesystem::absolute(trace) == std::filesystem::absolute(out)) {
@@ -116,7 +102,7 @@ int replay_command(const std::vector<std::string>& args, const std::atomic<bool>
   for (const std::string& note : plan.notes) std::cerr << "graspsim: replay: " << note << "\n";
 
   app::RunOptions options = plan.run_options(out);
-  options.trace.compression = compression;
+  options.trace.compression = static_cast<int>(compression);
   options.stop.interrupt = interrupt;
   options.stop.signal = signal;
   // The replay's trace is as large as the recording: refused if it will not fit.

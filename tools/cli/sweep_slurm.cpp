@@ -24,6 +24,11 @@ std::string run_slurm(const std::string& program, const Plan& plan, const std::s
   fs::create_directories(slurm, ec);
   if (ec) return "cannot make " + slurm.string() + ": " + ec.message();
   const std::string script = (slurm / "job.sh").string();
+  try {
+    check_replaceable(script);
+  } catch (const SweepError& e) {
+    return e.what();
+  }
   {
     std::ofstream out(script, std::ios::trunc);
     out << slurm_job_script(program, dir);

@@ -15,6 +15,7 @@
 #include <thread>
 #include <utility>
 
+#include "cli/options.hpp"
 #include "cli/report.hpp"
 #include "view/server/overlay.hpp"
 #include "view/server/server.hpp"
@@ -74,32 +75,21 @@ std::pair<view::Packed, std::string> load_ghost(const std::string& a, const std:
 int view_command(const std::vector<std::string>& args) {
   std::string trace, ghost;
   int port = kDefaultViewPort;
-  bool open = false;
-  for (std::size_t i = 0; i < args.size(); ++i) {
-    const std::string& a = args[i];
-    if (a == "-h" || a == "--help") {
-      std::cout << kViewHelp;
-      return kExitOk;
-    } else if (a == "--port") {
-      const std::string v = i + 1 < args.size() ? args[++i] : "";
-      char* end = nullptr;
-      const long p = std::strtol(v.c_str(), &end, 10);
-      if (v.empty() || *end != '\0' || p < 0 || p > 65535)
-        return bad("--port needs a port number from 0 to 65535 (got '" + v + "')");
-      port = static_cast<int>(p);
-    } else if (a == "--open") {
-      open = true;
-    } else if (a.rfind("-", 0) == 0) {
-      return bad("unknown option '" + a + "'\nusage: graspsim view TRACE.h5 [B.h5] [--port N] [--open]");
-    } else if (trace.empty()) {
-      trace = a;
-    } else if (ghost.empty()) {
-      ghost = a;
-    } else {
-      return bad("at most two traces (got '" + trace + "', '" + ghost + "' and '" + a + "')");
-    }
+  bool open = false, port_given = false;
+  CommandLine line{"view", "usage: graspsim view TRACE.h5 [B.h5] [--port N] [--open]\n", kViewHelp,
+                   {cli::port(port, port_given), flag("--open", open)}, {}};
+  line.operand = [&](const std::string& v) -> std::string {
+    if (trace.empty()) trace = v;
+    else if (ghost.empty()) ghost = v;
+    else return "at most two traces (got '" + trace + "', '" + ghost + "' and '" + v + "')";
+    return "";
+  };
+  switch (parse_command_line(line, args)) {
+    case Parsed::kHelp: return kExitOk;
+    case Parsed::kError: return kExitBadInput;
+    case Parsed::kGo: break;
   }
-  if (trace.empty()) return bad("view needs a trace file\nusage: graspsim view TRACE.h5 [B.h5] [--port N] [--open]");
+  if (trace.empty()) return usage_error(line, "view needs a trace file");
 
   // Stop signals are taken by one thread (sigwait), blocked in every other, the server's
   // workers included: they are created after this.

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "app/golden.hpp"
+#include "app/output_file.hpp"
 #include "graspsim/recordings/trace_reader.hpp"
 
 #ifndef GRASPSIM_SOURCE_DIR
@@ -47,6 +48,14 @@ int bless(const std::string& scenario_file, const fs::path& work, bool dry_run, 
   const std::string full = (work / (stem + ".full.h5")).string();
   const std::string fresh = (work / (stem + ".h5")).string();
   std::cout << stem << ": " << scenario_file << "\n";
+  // A golden replaces only a file: not a device, FIFO, socket or directory left at its path.
+  for (const std::string& path : {golden, golden + ".partial"}) {
+    if (const std::string what = app::not_replaceable(path); !what.empty()) {
+      std::cerr << "  error: " << path << " is " << what << ", not a regular file: bless replaces only files; "
+                << "move it away\n";
+      return 2;
+    }
+  }
   app::RunResult run;
   try {
     run = golden::run_for_golden(scenario_file, full);
@@ -117,7 +126,10 @@ int bless(const std::string& scenario_file, const fs::path& work, bool dry_run, 
   kept.blessed_changes = what;
   golden::decimate_trace(full, fresh, kept);
   fs::create_directories(fs::path(golden).parent_path());
-  fs::copy_file(fresh, golden, fs::copy_options::overwrite_existing);
+  // Whole or not at all: copied beside the golden, then renamed over it.
+  const std::string partial = golden + ".partial";
+  fs::copy_file(fresh, partial, fs::copy_options::overwrite_existing);
+  fs::rename(partial, golden);
   std::cout << "  wrote " << golden << " (" << kilobytes(size) << ", " << run.physics_ticks
             << " physics ticks)\n";
   return 0;

@@ -13,6 +13,7 @@
 #include <mutex>
 #include <thread>
 
+#include "app/json.hpp"
 #include "view/server/http.hpp"
 #include "view/server/pack.hpp"
 #include "view/server/scene.hpp"
@@ -203,7 +204,7 @@ void LiveServer::end(const LiveEnd& end, double wait_s) {
   if (im.pump.joinable()) im.pump.join();
   im.take_newest();   // the run's last snapshot, if the pump had not taken it: the channel's reader now
   std::unique_lock<std::mutex> lock(im.mutex);
-  im.end_message = "event: end\ndata: {\"status\":" + json_string(end.status) + ",\"trace\":" + json_string(end.trace) + "}\n\n";
+  im.end_message = "event: end\ndata: {\"status\":" + app::json_string(end.status) + ",\"trace\":" + app::json_string(end.trace) + "}\n\n";
   im.changed.notify_all();
   im.changed.wait_for(lock, std::chrono::duration<double>(wait_s), [&] { return im.unended == 0; });
 }

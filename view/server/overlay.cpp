@@ -1,11 +1,14 @@
 // The first divergence of two traces, from the comparison `graspsim compare` prints.
 #include "view/server/overlay.hpp"
 
+#include "app/json.hpp"
 #include "graspsim/recordings/trace_compare.hpp"
 #include "view/server/pack.hpp"
 #include "view/server/scene.hpp"
 
 namespace graspsim::view {
+
+using app::json_string;
 
 Divergence first_divergence(const std::string& a, const std::string& b) {
   recordings::CompareResult r;

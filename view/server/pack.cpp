@@ -1,6 +1,8 @@
 // The scene as JSON and the blob of columns the page animates.
 #include "view/server/pack.hpp"
 
+#include "app/json.hpp"
+
 #include <bit>
 #include <cstdint>
 #include <cstdio>
@@ -9,6 +11,8 @@
 
 namespace graspsim::view {
 namespace {
+
+using app::json_string;
 
 static_assert(std::endian::native == std::endian::little, "the blob is little-endian, as typed arrays read it");
 
@@ -83,23 +87,6 @@ std::string shape_json(const BodyView& b) {
 }
 
 }  // namespace
-
-std::string json_string(const std::string& text) {
-  std::string out = "\"";
-  for (const unsigned char c : text) {
-    if (c == '"' || c == '\\') {
-      out += '\\';
-      out += static_cast<char>(c);
-    } else if (c < 0x20) {
-      char buf[8];
-      std::snprintf(buf, sizeof buf, "\\u%04x", c);
-      out += buf;
-    } else {
-      out += static_cast<char>(c);
-    }
-  }
-  return out + "\"";
-}
 
 Packed pack_scene(const ViewScene& s) {
   Blob blob;

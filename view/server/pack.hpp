@@ -25,7 +25,4 @@ struct Packed {
 // (m), "finger/<j>/body" (index, -2 floor, -1 none) per /haptic row, all float64.
 Packed pack_scene(const ViewScene& scene);
 
-// `text` as a JSON string literal, quotes included.
-std::string json_string(const std::string& text);
-
 }  // namespace graspsim::view

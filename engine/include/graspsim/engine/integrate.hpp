@@ -61,8 +61,16 @@ void move_body(const BodyParams& params, BodyState& body, const Vec3& force, con
 void move_body_bdf2(BodyState& body, const Vec3& v1, const Vec3& w1, const Vec3& v_mean, const Vec3& w_mean,
                     double dt);
 
-// The gyroscopic change of the world angular velocity w over dt under `gyroscopic` (zero for
-// kNeglect), as integrate_body applies it before the torque's change.
+// The implicit integrator's gyroscopic change of the world angular velocity w over dt, taken
+// before its solve adds the torques' change: zero for kNeglect; for kExplicit and kImplicit alike
+// the torque-free part of Euler's equation, Jp w_b_dot = -w_b x Jp w_b, by the implicit midpoint
+// rule on the body-frame angular momentum (integrate.cpp derives it), which conserves the kinetic
+// energy and |L| exactly at any spin and rate. The integrator promises not to gain energy at any
+// rate; neither first-order scheme keeps that for a body spinning fast on its own (forward Euler
+// always gains, the one Newton step only while dt |w| <= Jmin / (2 Jmax)), and move_body turns the
+// body exactly about the end w, which leaves R^T w, and so the energy and |L|, as this change made
+// them: a free body tumbles at constant energy and |L| up to rounding. The paper's integrator
+// (integrate_body) keeps the options' own schemes, as the benchmark measures them.
 Vec3 gyroscopic_change(const BodyParams& params, Gyroscopic gyroscopic, const BodyState& body, double dt);
 
 }  // namespace graspsim
