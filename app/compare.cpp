@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <optional>
 #include <sstream>
+#include <stdexcept>
 
 #include "app/json.hpp"
 #include "graspsim/recordings/record_selection.hpp"
@@ -98,7 +99,13 @@ std::string missing_loop_tables(const std::string& trace) {
       recordings::has_attribute(trace, "/", "record")
           ? std::optional<std::string>(recordings::read_string_attribute(trace, "/", "record"))
           : std::nullopt;
-  const recordings::RecordSelection record = recordings::RecordSelection::from_attribute(attribute);
+  recordings::RecordSelection record;
+  try {
+    record = recordings::RecordSelection::from_attribute(attribute);
+  } catch (const std::invalid_argument& e) {   // a damaged or hand-edited attribute
+    return "'" + trace + "' is not a whole graspsim trace: its root attribute record '" + *attribute +
+           "' " + e.what();
+  }
   const std::vector<std::string> datasets = recordings::list_datasets(trace);
   const auto holds = [&](const std::string& path) { return std::binary_search(datasets.begin(), datasets.end(), path); };
   std::string missing;
