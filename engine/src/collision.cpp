@@ -86,7 +86,7 @@ std::optional<BoxEntry> box_entry(const Vec3& h, const Vec3& a, const Vec3& b) {
 }
 
 struct CollisionWorld::Impl {
-  std::shared_ptr<detail::FclWorld> world;     // the bodies' FCL objects, shared with BodyContacts
+  std::shared_ptr<detail::FclWorld> world;     // the bodies' FCL objects, shared with the contact gather (ContactGather)
   std::shared_ptr<fcl::Capsuled> path_shape;   // the finger path, resized per query
   std::unique_ptr<fcl::CollisionObjectd> path;
   std::vector<SurfaceGeometry> surfaces;   // same order as the bodies

@@ -1,6 +1,6 @@
 // The bodies as FCL objects in one dynamic AABB tree (private to the engine): what a free
 // finger's path asks (CollisionWorld) and what the body-body broadphase and narrowphase ask
-// (BodyContacts), one set of objects for both.
+// (ContactGather), one set of objects for both.
 #pragma once
 
 #include <memory>

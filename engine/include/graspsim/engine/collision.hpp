@@ -49,7 +49,7 @@ struct FclWorld;   // the bodies' FCL objects (engine/src/fcl_world.hpp)
 class CollisionWorld {
  public:
   // With `world`, the bodies' FCL objects are that world's, shared (Simulation shares one with
-  // BodyContacts); without, its own.
+  // its ContactGather); without, its own.
   explicit CollisionWorld(const Model& model, std::shared_ptr<detail::FclWorld> world = nullptr);
   ~CollisionWorld();
   CollisionWorld(CollisionWorld&&) noexcept;

@@ -23,7 +23,7 @@ namespace graspsim {
 // Floor and body points are unilateral with Coulomb friction: after the solve a point whose
 // normal force would pull is dropped, and one whose tangential force leaves the cone slips, its
 // tangential spring and damper replaced by a sliding force mu f_n (+ viscous) (an active set,
-// ImplicitStep::solve); its sliding force follows its normal force within the solve.
+// IslandSolve::solve); its sliding force follows its normal force within the solve.
 // Fingers are already held in their cone by the servo stage (mu < 0).
 struct Coupling {
   enum class Source : std::uint8_t { kFinger, kFloor, kBody };

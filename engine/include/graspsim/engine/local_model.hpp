@@ -16,7 +16,7 @@
 // differ by the velocity change that step makes times h: continuous up to it.
 //
 // The fingers' window forces are then measured at poses a mean time `lead` ahead of the step's
-// start pose, which the implicit step's finger couplings account for (simulation_implicit.cpp).
+// start pose, which the implicit step's finger couplings account for (implicit_stage.cpp).
 // Otherwise the fast loops see the physics pose (under integrator = "paper", bit for bit the
 // paper).
 #pragma once
