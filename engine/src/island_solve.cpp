@@ -111,34 +111,28 @@ void add_block(const BlockRef& a, const CouplingResponse& g, const Vec3& r_x, co
 
 }  // namespace
 
-// Where an island's system goes: the block solver's storage, or one dense row-major matrix.
-class IslandSolve::Sink {
- public:
-  virtual ~Sink() = default;
-  virtual BlockRef diagonal(int i) = 0;     // local body indices
-  virtual BlockRef block(int i, int j) = 0;
-  virtual double* rhs(int i) = 0;
-};
-
 namespace {
 
-class BlockSink final : public IslandSolve::Sink {
+// Where an island's system goes (IslandSolve::assemble's sink, chosen at compile time: the one
+// body's 6 x 6 system is assembled at every step of every resting body): the block solver's
+// storage, or one dense row-major matrix. Local body indices.
+class BlockSink {
  public:
   explicit BlockSink(BlockSparseSolver& s) : s_(s) {}
-  BlockRef diagonal(int i) override { return {s_.diagonal(i), s_.size(i)}; }
-  BlockRef block(int i, int j) override { return {s_.block(i, j), s_.size(j)}; }
-  double* rhs(int i) override { return s_.rhs(i); }
+  BlockRef diagonal(int i) { return {s_.diagonal(i), s_.size(i)}; }
+  BlockRef block(int i, int j) { return {s_.block(i, j), s_.size(j)}; }
+  double* rhs(int i) { return s_.rhs(i); }
 
  private:
   BlockSparseSolver& s_;
 };
 
-class DenseSink final : public IslandSolve::Sink {
+class DenseSink {
  public:
   DenseSink(double* m, double* r, int n, const std::vector<int>& offset) : m_(m), r_(r), n_(n), offset_(offset) {}
-  BlockRef diagonal(int i) override { return block(i, i); }
-  BlockRef block(int i, int j) override { return {m_ + offset_[i] * n_ + offset_[j], n_}; }
-  double* rhs(int i) override { return r_ + offset_[i]; }
+  BlockRef diagonal(int i) { return block(i, i); }
+  BlockRef block(int i, int j) { return {m_ + offset_[i] * n_ + offset_[j], n_}; }
+  double* rhs(int i) { return r_ + offset_[i]; }
 
  private:
   double* m_;
@@ -711,6 +705,7 @@ bool IslandSolve::solve_cached(const StepProblem& p, double h) {
 
 // M q^ + h Q and the couplings' h J^T G J and h J^T (force + C u0) into `sink` (local body
 // indices), in this round's modes; a rule's row and column in its body's diagonal block.
+template <class Sink>
 void IslandSolve::assemble(const StepProblem& p, double h, Sink& sink) {
   const State& state = p.state;
   for (int b : current_) {

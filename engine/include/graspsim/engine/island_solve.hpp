@@ -110,7 +110,6 @@ class IslandSolve {
   static constexpr int kCachedIslands = 4;
   static constexpr int kRefinements = 4;   // most refinement passes on kept factors
 
-  class Sink;   // where an island's system is assembled: the block solver, or a dense matrix
 
  private:
   // A large island's structure, its system as assembled, and the factors of an earlier system of
@@ -136,6 +135,7 @@ class IslandSolve {
   bool arrives(const Coupling& c, int i, const Vec3& u1, double h) const;
   bool merge_arrivals(const StepProblem& p);
   void assemble_and_solve(const StepProblem& p, double h);
+  template <class Sink>   // BlockSink or DenseSink (island_solve.cpp)
   void assemble(const StepProblem& p, double h, Sink& sink);
   std::uint64_t island_signature(const std::vector<Coupling>& couplings) const;
   Vec3 relative_velocity(const StepProblem& p, const Coupling& c, const std::vector<Vec3>& v,
