@@ -70,7 +70,6 @@ void BlockSparseSolver::order_by_minimum_degree(int begin, int end) {
     heap.emplace_back(-degree_[v], -v);   // a max-heap of (-degree, -index): fewest, then lowest
   }
   std::make_heap(heap.begin(), heap.end());
-  std::vector<int>& merged = merged_;
   while (!heap.empty()) {
     std::pop_heap(heap.begin(), heap.end());
     const auto [neg_degree, neg_node] = heap.back();
@@ -81,20 +80,28 @@ void BlockSparseSolver::order_by_minimum_degree(int begin, int end) {
     order_.push_back(k);
     const std::vector<int>& nk = adjacency_[k];
     for (int u : nk) {
-      merged.clear();
-      std::set_union(adjacency_[u].begin(), adjacency_[u].end(), nk.begin(), nk.end(), std::back_inserter(merged));
-      std::vector<int>& au = adjacency_[u];
-      au.clear();
-      for (int v : merged) {
-        if (v != u && v != k) au.push_back(v);
-      }
-      if (static_cast<int>(au.size()) != degree_[u]) {
-        degree_[u] = static_cast<int>(au.size());
+      join_neighbours(k, u);
+      const int degree = static_cast<int>(adjacency_[u].size());
+      if (degree != degree_[u]) {
+        degree_[u] = degree;
         heap.emplace_back(-degree_[u], -u);
         std::push_heap(heap.begin(), heap.end());
       }
     }
     adjacency_[k].clear();
+  }
+}
+
+// Eliminating node k joins its neighbours: neighbour u's adjacency becomes the union of its own
+// and k's, less u and k (both sorted, so a merge).
+void BlockSparseSolver::join_neighbours(int k, int u) {
+  const std::vector<int>& nk = adjacency_[k];
+  merged_.clear();
+  std::set_union(adjacency_[u].begin(), adjacency_[u].end(), nk.begin(), nk.end(), std::back_inserter(merged_));
+  std::vector<int>& au = adjacency_[u];
+  au.clear();
+  for (int v : merged_) {
+    if (v != u && v != k) au.push_back(v);
   }
 }
 
@@ -107,19 +114,12 @@ void BlockSparseSolver::eliminate_symbolic() {
     position_[i] = -1;
   }
   for (std::size_t p = 0; p < order_.size(); ++p) position_[order_[p]] = static_cast<int>(p);
-  std::vector<int>& merged = merged_;
   for (int k : order_) {
     const std::vector<int>& nk = adjacency_[k];   // the nodes left that k touches, sorted
     upper_[k].clear();
     for (int j : nk) upper_[k].push_back(Entry{j, -1});
     for (int u : nk) {
-      merged.clear();
-      std::set_union(adjacency_[u].begin(), adjacency_[u].end(), nk.begin(), nk.end(), std::back_inserter(merged));
-      std::vector<int>& au = adjacency_[u];
-      au.clear();
-      for (int v : merged) {
-        if (v != u && v != k) au.push_back(v);
-      }
+      join_neighbours(k, u);
     }
     adjacency_[k].clear();
   }

@@ -184,6 +184,24 @@ double scene_energy(const Model& m, const State& s, ContactGather& contacts) {
 
 }  // namespace
 
+namespace {
+
+// A cube of half side `a` (mass `mass`) corner down, tilted 0.087 rad off the vertical diagonal
+// so that it does not land exactly on its corner, its lowest corner `drop` above `top`, 1 cm off
+// the centre in x.
+BodyParams corner_down_cube(double a, double mass, double top, double drop, const Material& material) {
+  const Mat3 corner_down = (Eigen::AngleAxisd(0.087, Vec3(1.0, 2.0, 0.0).normalized()) *
+                            Eigen::AngleAxisd(std::atan(1.0 / std::sqrt(2.0)), Vec3::UnitY()) *
+                            Eigen::AngleAxisd(M_PI / 4.0, Vec3::UnitX())).toRotationMatrix();
+  double lowest = 0.0;
+  for (int k = 0; k < 8; ++k) lowest = std::min(lowest, (corner_down * box_vertex(Vec3(a, a, a), k)).z());
+  BodyParams cube = make_box("cube", mass, Vec3(a, a, a), Vec3(0.01, 0.0, top + drop - lowest), material);
+  cube.orientation = Quat(corner_down);
+  return cube;
+}
+
+}  // namespace
+
 // Dissipation: a 6 cm cube dropped corner first from 2 cm onto a 30 x 30 x 4 cm box resting on
 // the floor (wide, so that the cube stays within its top face: over its edge the contact changes
 // between edge-edge and face contact, whose depths differ, and energy is not conserved there;
@@ -204,15 +222,9 @@ TEST_CASE("a box dropped corner first on another box never gains energy", "[obje
     m.bodies.push_back(make_box("base", big_mass, big, Vec3(0.0, 0.0, big.z() - big_mass * kG / (4.0 * 40000.0)),
                                 Material{0.6, kInfinity, kInfinity}));
     const double a = 0.03, mass = 0.2;
-    const Mat3 corner_down = (Eigen::AngleAxisd(0.087, Vec3(1.0, 2.0, 0.0).normalized()) *
-                              Eigen::AngleAxisd(std::atan(1.0 / std::sqrt(2.0)), Vec3::UnitY()) *
-                              Eigen::AngleAxisd(M_PI / 4.0, Vec3::UnitX())).toRotationMatrix();
-    double lowest = 0.0;
-    for (int k = 0; k < 8; ++k) lowest = std::min(lowest, (corner_down * box_vertex(Vec3(a, a, a), k)).z());
     const double top = m.bodies[0].position.z() + big.z();
     const double drop = 0.02;
-    BodyParams cube = make_box("cube", mass, Vec3(a, a, a), Vec3(0.01, 0.0, top + drop - lowest), Material{0.6, 500.0, 3.0});
-    cube.orientation = Quat(corner_down);
+    const BodyParams cube = corner_down_cube(a, mass, top, drop, Material{0.6, 500.0, 3.0});
     m.bodies.push_back(cube);
     Simulation sim(m);
     ContactGather probe(m);
@@ -258,14 +270,8 @@ TEST_CASE("a box dropped corner first on another box never gains energy under th
   const Vec3 big(0.15, 0.15, 0.02);
   m.bodies.push_back(make_box("base", 2.0, big, Vec3(0.0, 0.0, big.z()), Material{0.6, kInfinity, kInfinity}));
   const double a = 0.03, mass = 0.2;
-  const Mat3 corner_down = (Eigen::AngleAxisd(0.087, Vec3(1.0, 2.0, 0.0).normalized()) *
-                            Eigen::AngleAxisd(std::atan(1.0 / std::sqrt(2.0)), Vec3::UnitY()) *
-                            Eigen::AngleAxisd(M_PI / 4.0, Vec3::UnitX())).toRotationMatrix();
-  double lowest = 0.0;
-  for (int k = 0; k < 8; ++k) lowest = std::min(lowest, (corner_down * box_vertex(Vec3(a, a, a), k)).z());
   const double top = 2.0 * big.z(), drop = 0.02;
-  BodyParams cube = make_box("cube", mass, Vec3(a, a, a), Vec3(0.01, 0.0, top + drop - lowest), Material{0.6, kInfinity, kInfinity});
-  cube.orientation = Quat(corner_down);
+  const BodyParams cube = corner_down_cube(a, mass, top, drop, Material{0.6, kInfinity, kInfinity});
   m.bodies.push_back(cube);
   Simulation sim(m);
   ContactGather probe(sim.model());

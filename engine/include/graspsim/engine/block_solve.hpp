@@ -81,6 +81,7 @@ class BlockSparseSolver {
   void order_by_minimum_degree(int begin, int end);
   void eliminate_symbolic();
   void symbolic_fill();
+  void join_neighbours(int k, int u);   // eliminating k: u joins k's neighbours
   bool factor_block(int k);
 
   int n_ = 0;
